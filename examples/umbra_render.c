@@ -1,0 +1,378 @@
+/* umbra-render: the command-line front end. Renders a built-in scene or a volume file with a
+ * chosen shadow technique into a PNG or EXR and prints each stage's time to stderr.
+ * Run with --help for the options. Exit status: 0 on success, 1 on bad input, 2 on a failure. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "umbra/umbra.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: umbra-render [options]\n"
+        "  --scene NAME          built-in scene: spheres (default), slab, marschner-lobb\n"
+        "  --scene-size N        built-in scene resolution N^3 (default per scene)\n"
+        "  --volume FILE         volume file: .nrrd/.nhdr (Teem) or .dat (Voreen)\n"
+        "  --raw FILE --raw-dims XxYxZ --raw-type uint8|uint16|int16|float32 [--raw-big-endian]\n"
+        "  --tf FILE             transfer function (text format, see README)\n"
+        "  --light-tf FILE       separate transfer function for the light pass\n"
+        "  --size WxH            image size (default 512x512)\n"
+        "  --out FILE            output image, .png or .exr (default umbra.png)\n"
+        "  --technique NAME      none | reference | threshold | deep | cssm | convolution\n"
+        "  --camera-dir X,Y,Z    orbit camera from this direction\n"
+        "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z   look-at camera\n"
+        "  --fov DEG             vertical field of view (default 30)\n"
+        "  --ortho H             orthographic camera of view height H\n"
+        "  --light-dir X,Y,Z     directional light travelling along X,Y,Z\n"
+        "  --light-pos X,Y,Z     point light at X,Y,Z (world units, volume centred at 0)\n"
+        "  --light-color R,G,B   light colour (default 1,1,1)\n"
+        "  --ambient A           ambient light (default 0.2)\n"
+        "  --step S              view sampling step in voxels (default 0.5)\n"
+        "  --shading | --no-shading   Blinn-Phong gradient shading\n"
+        "  --ground | --no-ground     opaque ground plane receiving shadows\n"
+        "  --colored | --grey    transmission colour from the light TF's RGB, or grey\n"
+        "  --background R,G,B,A  premultiplied background (default 0.08,0.08,0.1,1)\n"
+        "  --jitter              jitter ray starts (seeded by --seed)\n"
+        "  --seed N              seed for jitter and stochastic maps\n"
+        "  --device SPEC         OpenCL device: P:D indices or a name substring\n"
+        "  --reference-step S    reference: shadow-ray step in voxels (default 0.25)\n"
+        "  --map-size N --map-step S --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
+        "  --block-size K --prefilter 1|5 --no-lookup-table      light-space map parameters\n"
+        "  --slice-distance S --subsamples N --preintegrated --cone-angle DEG  convolution\n");
+}
+
+static int parse_floats(const char *s, float *out, int n)
+{
+    for (int i = 0; i < n; ++i) {
+        char *end;
+        errno = 0;
+        out[i] = strtof(s, &end);
+        if (end == s || errno || !isfinite(out[i]))
+            return 0;
+        s = end;
+        if (i + 1 < n) {
+            if (*s != ',')
+                return 0;
+            ++s;
+        }
+    }
+    return *s == 0;
+}
+
+static int parse_uint(const char *s, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 10);
+    if (end == s || *end || errno || v > 0xffffffffUL || s[0] == '-')
+        return 0;
+    *out = (uint32_t)v;
+    return 1;
+}
+
+static int parse_size(const char *s, uint32_t *w, uint32_t *h)
+{
+    char tail;
+    unsigned a, b;
+    if (sscanf(s, "%ux%u%c", &a, &b, &tail) != 2 || a == 0 || b == 0 || a > 16384 || b > 16384)
+        return 0;
+    *w = a;
+    *h = b;
+    return 1;
+}
+
+static void on_error(void *user, umbra_status st, const char *msg)
+{
+    (void)user;
+    fprintf(stderr, "umbra-render: %s: %s\n", umbra_status_to_string(st), msg);
+}
+
+#define BAD(...)                                                                               \
+    do {                                                                                       \
+        fprintf(stderr, "umbra-render: " __VA_ARGS__);                                         \
+        fputc('\n', stderr);                                                                   \
+        return 1;                                                                              \
+    } while (0)
+
+typedef struct options {
+    const char *scene, *volume, *raw, *tf, *light_tf, *out, *device;
+    uint32_t scene_size, width, height;
+    umbra_raw_desc raw_desc;
+    int have_raw_dims, have_raw_type;
+    float camera_dir[3], eye[3], target[3], up[3], fov, ortho;
+    int have_camera_dir, have_eye, have_target, have_up;
+    float light_dir[3], light_pos[3], light_color[3], ambient, step, background[4];
+    int have_light_dir, have_light_pos, have_light_color, have_ambient, have_step;
+    int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
+    uint32_t seed;
+    umbra_shadow_desc shadow;
+} options;
+
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->scene = "spheres";
+    o->out = "umbra.png";
+    o->width = o->height = 512;
+    o->fov = 30.0f;
+    o->shading = o->ground = o->colored = -1;
+    umbra_raw_desc_init(&o->raw_desc);
+    umbra_shadow_desc_init(&o->shadow);
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+#define FLAG(name) (strcmp(a, name) == 0)
+#define NEED()                                                                                 \
+    do {                                                                                       \
+        if (!v)                                                                                \
+            BAD("%s needs a value", a);                                                        \
+        ++i;                                                                                   \
+    } while (0)
+        if (FLAG("--help") || FLAG("-h")) {
+            usage(stdout);
+            exit(0);
+        } else if (FLAG("--scene")) { NEED(); o->scene = v; }
+        else if (FLAG("--scene-size")) { NEED(); if (!parse_uint(v, &o->scene_size)) BAD("--scene-size '%s' is not a whole number", v); }
+        else if (FLAG("--volume")) { NEED(); o->volume = v; }
+        else if (FLAG("--raw")) { NEED(); o->raw = v; }
+        else if (FLAG("--raw-dims")) {
+            NEED();
+            char tail;
+            unsigned x, y, z;
+            if (sscanf(v, "%ux%ux%u%c", &x, &y, &z, &tail) != 3)
+                BAD("--raw-dims '%s' is not XxYxZ", v);
+            o->raw_desc.dims[0] = x; o->raw_desc.dims[1] = y; o->raw_desc.dims[2] = z;
+            o->have_raw_dims = 1;
+        } else if (FLAG("--raw-type")) {
+            NEED();
+            static const char *names[] = {"uint8", "uint16", "int16", "float32"};
+            int k = -1;
+            for (int t = 0; t < 4; ++t)
+                if (strcmp(v, names[t]) == 0)
+                    k = t;
+            if (k < 0)
+                BAD("--raw-type '%s' is not uint8, uint16, int16 or float32", v);
+            o->raw_desc.type = (umbra_scalar_type)k;
+            o->have_raw_type = 1;
+        } else if (FLAG("--raw-big-endian")) o->raw_desc.big_endian = 1;
+        else if (FLAG("--tf")) { NEED(); o->tf = v; }
+        else if (FLAG("--light-tf")) { NEED(); o->light_tf = v; }
+        else if (FLAG("--size")) { NEED(); if (!parse_size(v, &o->width, &o->height)) BAD("--size '%s' is not WxH with sides in [1, 16384]", v); }
+        else if (FLAG("--out")) { NEED(); o->out = v; }
+        else if (FLAG("--technique")) {
+            NEED();
+            if (umbra_shadow_technique_parse(v, &o->shadow.technique) != UMBRA_SUCCESS)
+                BAD("--technique '%s' is unknown (none, reference, threshold, deep, cssm, convolution)", v);
+        }
+        else if (FLAG("--camera-dir")) { NEED(); if (!parse_floats(v, o->camera_dir, 3)) BAD("--camera-dir '%s' is not X,Y,Z", v); o->have_camera_dir = 1; }
+        else if (FLAG("--eye")) { NEED(); if (!parse_floats(v, o->eye, 3)) BAD("--eye '%s' is not X,Y,Z", v); o->have_eye = 1; }
+        else if (FLAG("--target")) { NEED(); if (!parse_floats(v, o->target, 3)) BAD("--target '%s' is not X,Y,Z", v); o->have_target = 1; }
+        else if (FLAG("--up")) { NEED(); if (!parse_floats(v, o->up, 3)) BAD("--up '%s' is not X,Y,Z", v); o->have_up = 1; }
+        else if (FLAG("--fov")) { NEED(); if (!parse_floats(v, &o->fov, 1)) BAD("--fov '%s' is not a number", v); }
+        else if (FLAG("--ortho")) { NEED(); if (!parse_floats(v, &o->ortho, 1) || !(o->ortho > 0)) BAD("--ortho '%s' is not a positive number", v); }
+        else if (FLAG("--light-dir")) { NEED(); if (!parse_floats(v, o->light_dir, 3)) BAD("--light-dir '%s' is not X,Y,Z", v); o->have_light_dir = 1; }
+        else if (FLAG("--light-pos")) { NEED(); if (!parse_floats(v, o->light_pos, 3)) BAD("--light-pos '%s' is not X,Y,Z", v); o->have_light_pos = 1; }
+        else if (FLAG("--light-color")) { NEED(); if (!parse_floats(v, o->light_color, 3)) BAD("--light-color '%s' is not R,G,B", v); o->have_light_color = 1; }
+        else if (FLAG("--ambient")) { NEED(); if (!parse_floats(v, &o->ambient, 1)) BAD("--ambient '%s' is not a number", v); o->have_ambient = 1; }
+        else if (FLAG("--step")) { NEED(); if (!parse_floats(v, &o->step, 1)) BAD("--step '%s' is not a number", v); o->have_step = 1; }
+        else if (FLAG("--background")) { NEED(); if (!parse_floats(v, o->background, 4)) BAD("--background '%s' is not R,G,B,A", v); o->have_background = 1; }
+        else if (FLAG("--shading")) o->shading = 1;
+        else if (FLAG("--no-shading")) o->shading = 0;
+        else if (FLAG("--ground")) o->ground = 1;
+        else if (FLAG("--no-ground")) o->ground = 0;
+        else if (FLAG("--colored")) o->colored = 1;
+        else if (FLAG("--grey")) o->colored = 0;
+        else if (FLAG("--jitter")) o->jitter = 1;
+        else if (FLAG("--seed")) { NEED(); if (!parse_uint(v, &o->seed)) BAD("--seed '%s' is not a whole number", v); o->have_seed = 1; o->shadow.seed = o->seed; }
+        else if (FLAG("--device")) { NEED(); o->device = v; }
+        else if (FLAG("--reference-step")) { NEED(); if (!parse_floats(v, &o->shadow.reference_step, 1)) BAD("--reference-step '%s' is not a number", v); }
+        else if (FLAG("--map-size")) { NEED(); if (!parse_uint(v, &o->shadow.map_size)) BAD("--map-size '%s' is not a whole number", v); }
+        else if (FLAG("--map-step")) { NEED(); if (!parse_floats(v, &o->shadow.map_step, 1)) BAD("--map-step '%s' is not a number", v); }
+        else if (FLAG("--threshold")) { NEED(); if (!parse_floats(v, &o->shadow.threshold, 1)) BAD("--threshold '%s' is not a number", v); }
+        else if (FLAG("--taps")) { NEED(); if (!parse_uint(v, &o->shadow.taps)) BAD("--taps '%s' is not a whole number", v); }
+        else if (FLAG("--epsilon")) { NEED(); if (!parse_floats(v, &o->shadow.epsilon, 1)) BAD("--epsilon '%s' is not a number", v); }
+        else if (FLAG("--nodes")) { NEED(); if (!parse_uint(v, &o->shadow.max_nodes)) BAD("--nodes '%s' is not a whole number", v); }
+        else if (FLAG("--block-size")) { NEED(); if (!parse_uint(v, &o->shadow.block_size)) BAD("--block-size '%s' is not a whole number", v); }
+        else if (FLAG("--prefilter")) { NEED(); if (!parse_uint(v, &o->shadow.prefilter)) BAD("--prefilter '%s' is not a whole number", v); }
+        else if (FLAG("--no-lookup-table")) o->shadow.lookup_table = 0;
+        else if (FLAG("--slice-distance")) { NEED(); if (!parse_floats(v, &o->shadow.slice_distance, 1)) BAD("--slice-distance '%s' is not a number", v); }
+        else if (FLAG("--subsamples")) { NEED(); if (!parse_uint(v, &o->shadow.subsamples)) BAD("--subsamples '%s' is not a whole number", v); }
+        else if (FLAG("--preintegrated")) o->shadow.preintegrated = 1;
+        else if (FLAG("--cone-angle")) { NEED(); if (!parse_floats(v, &o->shadow.cone_angle_degrees, 1)) BAD("--cone-angle '%s' is not a number", v); }
+        else BAD("unknown option '%s' (see --help)", a);
+#undef FLAG
+#undef NEED
+    }
+    if (o->raw && (!o->have_raw_dims || !o->have_raw_type))
+        BAD("--raw needs --raw-dims and --raw-type");
+    if (o->have_light_dir && o->have_light_pos)
+        BAD("--light-dir and --light-pos exclude each other");
+    return 0;
+}
+
+/* Everything the render needs; released in one place. */
+typedef struct session {
+    umbra_context ctx;
+    umbra_scene scene;
+    umbra_volume volume;
+    umbra_transfer_function tf, light_tf;
+    umbra_renderer renderer;
+    float *pixels;
+} session;
+
+static void session_end(session *s)
+{
+    free(s->pixels);
+    umbra_renderer_release(s->renderer);
+    umbra_transfer_function_release(s->light_tf);
+    umbra_transfer_function_release(s->tf);
+    umbra_volume_release(s->volume);
+    umbra_scene_release(&s->scene);
+    umbra_context_release(s->ctx);
+}
+
+static int run(const options *o, session *s)
+{
+    umbra_context_desc cd;
+    umbra_context_desc_init(&cd);
+    cd.device_name = o->device;
+    cd.error_callback = on_error;
+    if (umbra_context_create(&cd, &s->ctx) != UMBRA_SUCCESS)
+        return 2;
+    fprintf(stderr, "device: %s\n", umbra_context_device_name(s->ctx));
+    double t0 = 0;
+    (void)t0;
+    umbra_volume vol = NULL;
+    umbra_transfer_function tf = NULL;
+    umbra_render_desc rd;
+    umbra_render_desc_init(&rd);
+    umbra_camera cam;
+    umbra_light light;
+    int input_error = 0;
+    if (o->volume || o->raw) {
+        umbra_status st = o->volume ? umbra_volume_load(s->ctx, o->volume, &s->volume)
+                                    : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
+        if (st != UMBRA_SUCCESS)
+            return 1;
+        vol = s->volume;
+        umbra_volume_info info;
+        umbra_volume_get_info(vol, &info);
+        float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
+                           info.extent[2] * info.extent[2]);
+        const float dir[3] = {0.75f, 0.5f, 1.0f};
+        cam = umbra_camera_orbit(dir, diag, o->fov);
+        memset(&light, 0, sizeof light);
+        light.type = UMBRA_LIGHT_DIRECTIONAL;
+        light.direction[0] = 0.45f;
+        light.direction[1] = -1.0f;
+        light.direction[2] = 0.25f;
+        light.color[0] = light.color[1] = light.color[2] = 1.0f;
+        rd.ground_plane = 1;
+        if (!o->tf) {
+            /* A generic ramp: low values transparent, high values white and denser. */
+            const umbra_tf_point pts[] = {{0.0f, {1, 1, 1, 0}}, {0.2f, {1, 1, 1, 0}},
+                                          {0.5f, {0.9f, 0.8f, 0.7f, 0.05f}},
+                                          {1.0f, {1, 1, 1, 0.4f}}};
+            if (umbra_transfer_function_create_from_points(s->ctx, pts, 4, 256, &s->tf))
+                return 2;
+            tf = s->tf;
+        }
+    } else {
+        if (umbra_scene_create(s->ctx, o->scene, o->scene_size, &s->scene) != UMBRA_SUCCESS)
+            return 1;
+        vol = s->scene.volume;
+        tf = s->scene.tf;
+        cam = s->scene.camera;
+        light = s->scene.light;
+        rd = s->scene.options;
+    }
+    if (o->tf) {
+        if (umbra_transfer_function_load(s->ctx, o->tf, &s->tf) != UMBRA_SUCCESS)
+            return 1;
+        tf = s->tf;
+    }
+    if (o->light_tf && umbra_transfer_function_load(s->ctx, o->light_tf, &s->light_tf) != UMBRA_SUCCESS)
+        return 1;
+
+    if (o->have_camera_dir) {
+        umbra_volume_info info;
+        umbra_volume_get_info(vol, &info);
+        float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
+                           info.extent[2] * info.extent[2]);
+        cam = umbra_camera_orbit(o->camera_dir, diag * 1.1f, o->fov);
+    }
+    if (o->have_eye) memcpy(cam.eye, o->eye, sizeof cam.eye);
+    if (o->have_target) memcpy(cam.target, o->target, sizeof cam.target);
+    if (o->have_up) memcpy(cam.up, o->up, sizeof cam.up);
+    cam.fovy_degrees = o->fov;
+    if (o->ortho > 0) {
+        cam.projection = UMBRA_ORTHOGRAPHIC;
+        cam.ortho_height = o->ortho;
+    }
+    if (o->have_light_dir) {
+        light.type = UMBRA_LIGHT_DIRECTIONAL;
+        memcpy(light.direction, o->light_dir, sizeof light.direction);
+    }
+    if (o->have_light_pos) {
+        light.type = UMBRA_LIGHT_POINT;
+        memcpy(light.position, o->light_pos, sizeof light.position);
+    }
+    if (o->have_light_color) memcpy(light.color, o->light_color, sizeof light.color);
+    if (o->have_ambient) rd.ambient[0] = rd.ambient[1] = rd.ambient[2] = o->ambient;
+    if (o->have_step) rd.step = o->step;
+    if (o->shading >= 0) rd.shading = o->shading;
+    if (o->ground >= 0) rd.ground_plane = o->ground;
+    if (o->colored >= 0) rd.transmission = o->colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
+    rd.jitter = o->jitter;
+    if (o->have_seed) rd.seed = o->seed;
+    if (o->have_background) memcpy(rd.background, o->background, sizeof rd.background);
+    else { rd.background[0] = 0.08f; rd.background[1] = 0.08f; rd.background[2] = 0.1f; rd.background[3] = 1.0f; }
+
+    if (umbra_renderer_create(s->ctx, &s->renderer) != UMBRA_SUCCESS)
+        return 2;
+    umbra_renderer r = s->renderer;
+    if (umbra_renderer_set_volume(r, vol) || umbra_renderer_set_transfer_function(r, tf) ||
+        (s->light_tf && umbra_renderer_set_light_transfer_function(r, s->light_tf)) ||
+        umbra_renderer_set_camera(r, &cam) || umbra_renderer_set_light(r, &light) ||
+        umbra_renderer_set_options(r, &rd) || umbra_renderer_set_shadow(r, &o->shadow))
+        input_error = 1;
+    if (input_error)
+        return 1;
+    s->pixels = malloc((size_t)o->width * o->height * 4 * sizeof(float));
+    if (!s->pixels) {
+        fprintf(stderr, "umbra-render: out of memory for a %ux%u image\n", o->width, o->height);
+        return 2;
+    }
+    if (umbra_renderer_render(r, o->width, o->height, s->pixels) != UMBRA_SUCCESS)
+        return 2;
+    umbra_render_stats stats;
+    umbra_renderer_get_stats(r, &stats);
+    fprintf(stderr, "technique: %s (%u light channel%s)\n",
+            umbra_shadow_technique_name(o->shadow.technique), stats.light_channels,
+            stats.light_channels == 1 ? "" : "s");
+    fprintf(stderr, "shadow build: %.2f ms\n", stats.shadow_build_ms);
+    fprintf(stderr, "render: %.2f ms (%llu samples)\n", stats.render_ms,
+            (unsigned long long)stats.samples);
+    fprintf(stderr, "shadow memory: %zu bytes\n", stats.shadow_memory_bytes);
+    if (stats.slices)
+        fprintf(stderr, "slices: %u\n", stats.slices);
+    if (umbra_image_write(s->ctx, o->out, o->width, o->height, s->pixels) != UMBRA_SUCCESS)
+        return 2;
+    fprintf(stderr, "wrote %s\n", o->out);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    if (parse_args(argc, argv, &o) != 0)
+        return 1;
+    session s;
+    memset(&s, 0, sizeof s);
+    int rc = run(&o, &s);
+    session_end(&s);
+    return rc;
+}

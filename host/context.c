@@ -1,0 +1,462 @@
+/* host/context.c: choosing an OpenCL device, owning (or retaining) its context and queue, and
+ * the per-context cache of built programs.
+ *
+ * Device choice, in order: desc's platform/device indices or name substring; else, with
+ * use_environment, $UMBRA_DEVICE ("P:D" indices or a name substring); else the first GPU, else
+ * the first device of any type. PoCL needs a writable kernel cache: unless $POCL_CACHE_DIR is set,
+ * it is pointed at desc->cache_dir or a directory under $TMPDIR (or /tmp) before OpenCL starts,
+ * so a user whose HOME is read-only still gets a working context. */
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "internal.h"
+
+struct umbra__program {
+    umbra__program *next;
+    char *key;          /* file names and options: what makes two programs the same */
+    cl_program program;
+};
+
+void umbra_context_desc_init(umbra_context_desc *desc)
+{
+    if (!desc)
+        return;
+    memset(desc, 0, sizeof *desc);
+    desc->struct_size = sizeof *desc;
+    desc->platform_index = -1;
+    desc->device_index = -1;
+    desc->use_environment = 1;
+    desc->sampler = UMBRA_SAMPLER_AUTO;
+}
+
+static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
+    UMBRA_PRINTF(3, 4);
+static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
+{
+    if (!desc || !desc->error_callback)
+        return;
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    desc->error_callback(desc->error_user, st, msg);
+}
+
+/* PoCL reads POCL_CACHE_DIR when the platform initialises; set it only if the user has not. */
+static void prepare_pocl_cache(const umbra_context_desc *desc)
+{
+    if (getenv("POCL_CACHE_DIR"))
+        return;
+    char dir[1024];
+    if (desc && desc->cache_dir) {
+        snprintf(dir, sizeof dir, "%s", desc->cache_dir);
+    } else {
+        const char *tmp = getenv("TMPDIR");
+        snprintf(dir, sizeof dir, "%s/umbra-pocl-cache-%ld", tmp && *tmp ? tmp : "/tmp",
+                 (long)getuid());
+    }
+    if (mkdir(dir, 0700) == 0 || errno == EEXIST)
+        setenv("POCL_CACHE_DIR", dir, 0);
+}
+
+static int contains_ci(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; *hay; ++hay) {
+        size_t i = 0;
+        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+            ++i;
+        if (i == n)
+            return 1;
+    }
+    return n == 0;
+}
+
+typedef struct selection {
+    int platform, device;
+    const char *name;
+} selection;
+
+static selection selection_from(const umbra_context_desc *d)
+{
+    selection s = {d->platform_index, d->device_index, d->device_name};
+    if (s.platform < 0 && s.device < 0 && !s.name && d->use_environment) {
+        const char *env = getenv("UMBRA_DEVICE");
+        int p, q;
+        char tail;
+        if (env && *env) {
+            if (sscanf(env, "%d:%d%c", &p, &q, &tail) == 2) {
+                s.platform = p;
+                s.device = q;
+            } else {
+                s.name = env;
+            }
+        }
+    }
+    return s;
+}
+
+static umbra_status pick_device(const umbra_context_desc *desc, cl_platform_id *out_platform,
+                                cl_device_id *out_device)
+{
+    cl_platform_id platforms[16];
+    cl_uint np = 0;
+    selection sel = selection_from(desc);
+    cl_int err = clGetPlatformIDs(16, platforms, &np);
+    if (err != CL_SUCCESS || np == 0) {
+        report(desc, UMBRA_ERROR_NO_DEVICE,
+               "umbra_context_create: no OpenCL platform found (clGetPlatformIDs: %s); install an "
+               "ICD such as pocl-opencl-icd", umbra__cl_error_name(err));
+        return UMBRA_ERROR_NO_DEVICE;
+    }
+    /* Two passes without an explicit choice: GPUs first, then anything. */
+    for (int pass = 0; pass < 2; ++pass) {
+        cl_device_type want = (pass == 0 && sel.platform < 0 && sel.device < 0 && !sel.name)
+                                  ? CL_DEVICE_TYPE_GPU
+                                  : CL_DEVICE_TYPE_ALL;
+        for (cl_uint p = 0; p < np; ++p) {
+            if (sel.platform >= 0 && (cl_uint)sel.platform != p)
+                continue;
+            cl_device_id devices[64];
+            cl_uint nd = 0;
+            if (clGetDeviceIDs(platforms[p], want, 64, devices, &nd) != CL_SUCCESS)
+                continue;
+            char pname[256] = "";
+            clGetPlatformInfo(platforms[p], CL_PLATFORM_NAME, sizeof pname, pname, NULL);
+            for (cl_uint i = 0; i < nd; ++i) {
+                if (sel.device >= 0 && (cl_uint)sel.device != i)
+                    continue;
+                char dname[256] = "";
+                clGetDeviceInfo(devices[i], CL_DEVICE_NAME, sizeof dname, dname, NULL);
+                if (sel.name && !contains_ci(dname, sel.name) && !contains_ci(pname, sel.name))
+                    continue;
+                *out_platform = platforms[p];
+                *out_device = devices[i];
+                return UMBRA_SUCCESS;
+            }
+        }
+    }
+    report(desc, UMBRA_ERROR_NO_DEVICE,
+           "umbra_context_create: no OpenCL device matches platform %d, device %d, name '%s' "
+           "(%u platforms found)", sel.platform, sel.device, sel.name ? sel.name : "",
+           (unsigned)np);
+    return UMBRA_ERROR_NO_DEVICE;
+}
+
+/* Fills the device facts and picks the sampler back end. */
+static void describe_device(umbra_context ctx, const umbra_context_desc *desc)
+{
+    char pname[256] = "", dname[256] = "";
+    cl_device_type type = 0;
+    cl_bool images = CL_FALSE;
+    clGetPlatformInfo(ctx->platform, CL_PLATFORM_NAME, sizeof pname, pname, NULL);
+    clGetDeviceInfo(ctx->device, CL_DEVICE_NAME, sizeof dname, dname, NULL);
+    clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL);
+    clGetDeviceInfo(ctx->device, CL_DEVICE_IMAGE_SUPPORT, sizeof images, &images, NULL);
+    snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", pname, dname);
+    ctx->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
+
+    ctx->has_float_r_image3d = 0;
+    if (images) {
+        cl_image_format formats[256];
+        cl_uint nf = 0;
+        if (clGetSupportedImageFormats(ctx->cl_ctx, CL_MEM_READ_ONLY, CL_MEM_OBJECT_IMAGE3D, 256,
+                                       formats, &nf) == CL_SUCCESS) {
+            for (cl_uint i = 0; i < nf && i < 256; ++i)
+                if (formats[i].image_channel_order == CL_R &&
+                    formats[i].image_channel_data_type == CL_FLOAT)
+                    ctx->has_float_r_image3d = 1;
+        }
+    }
+    umbra_sampler_kind want = desc ? desc->sampler : UMBRA_SAMPLER_AUTO;
+    if (want == UMBRA_SAMPLER_AUTO)
+        want = (!ctx->is_cpu && ctx->has_float_r_image3d) ? UMBRA_SAMPLER_IMAGE : UMBRA_SAMPLER_BUFFER;
+    if (want == UMBRA_SAMPLER_IMAGE && !ctx->has_float_r_image3d)
+        want = UMBRA_SAMPLER_BUFFER;
+    ctx->sampler = want;
+}
+
+static umbra_status context_alloc(const umbra_context_desc *desc, umbra_context *out)
+{
+    umbra_context ctx = calloc(1, sizeof *ctx);
+    if (!ctx) {
+        report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: out of host memory");
+        return UMBRA_ERROR_OUT_OF_MEMORY;
+    }
+    ctx->refs = 1;
+    if (desc) {
+        ctx->callback = desc->error_callback;
+        ctx->callback_user = desc->error_user;
+    }
+    *out = ctx;
+    return UMBRA_SUCCESS;
+}
+
+static int desc_ok(const umbra_context_desc *desc)
+{
+    if (desc && desc->struct_size != sizeof *desc) {
+        report(desc, UMBRA_ERROR_INVALID_ARGUMENT,
+               "umbra_context_create: desc->struct_size %zu != %zu: call umbra_context_desc_init",
+               desc->struct_size, sizeof *desc);
+        return 0;
+    }
+    if (desc && (desc->sampler < UMBRA_SAMPLER_AUTO || desc->sampler > UMBRA_SAMPLER_IMAGE)) {
+        report(desc, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_context_create: sampler %d is unknown",
+               (int)desc->sampler);
+        return 0;
+    }
+    return 1;
+}
+
+umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context *out)
+{
+    if (!out) {
+        report(desc, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_context_create: out is NULL");
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if (!desc_ok(desc))
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    umbra_context_desc defaults;
+    if (!desc) {
+        umbra_context_desc_init(&defaults);
+        desc = &defaults;
+    }
+    prepare_pocl_cache(desc);
+
+    umbra_context ctx = NULL;
+    umbra_status st = context_alloc(desc, &ctx);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    st = pick_device(desc, &ctx->platform, &ctx->device);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    cl_int err;
+    ctx->cl_ctx = clCreateContext(NULL, 1, &ctx->device, NULL, NULL, &err);
+    UMBRA_CL_CHECK(err, "clCreateContext");
+    ctx->queue = clCreateCommandQueue(ctx->cl_ctx, ctx->device, CL_QUEUE_PROFILING_ENABLE, &err);
+    UMBRA_CL_CHECK(err, "clCreateCommandQueue");
+    describe_device(ctx, desc);
+    *out = ctx;
+    return UMBRA_SUCCESS;
+fail:
+    umbra_context_release(ctx);
+    return st;
+}
+
+umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device,
+                                          cl_command_queue queue,
+                                          const umbra_context_desc *desc, umbra_context *out)
+{
+    if (!out || !cl_ctx || !device || !queue) {
+        report(desc, UMBRA_ERROR_INVALID_ARGUMENT,
+               "umbra_context_create_from_cl: cl_ctx %p, device %p, queue %p, out %p: none may "
+               "be NULL", (void *)cl_ctx, (void *)device, (void *)queue, (void *)out);
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if (!desc_ok(desc))
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    cl_context qctx = NULL;
+    cl_device_id qdev = NULL;
+    if (clGetCommandQueueInfo(queue, CL_QUEUE_CONTEXT, sizeof qctx, &qctx, NULL) != CL_SUCCESS ||
+        clGetCommandQueueInfo(queue, CL_QUEUE_DEVICE, sizeof qdev, &qdev, NULL) != CL_SUCCESS ||
+        qctx != cl_ctx || qdev != device) {
+        report(desc, UMBRA_ERROR_INVALID_ARGUMENT,
+               "umbra_context_create_from_cl: queue %p does not belong to context %p and device %p",
+               (void *)queue, (void *)cl_ctx, (void *)device);
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    }
+    umbra_context ctx = NULL;
+    umbra_status st = context_alloc(desc, &ctx);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    clRetainContext(cl_ctx);
+    clRetainCommandQueue(queue);
+    ctx->cl_ctx = cl_ctx;
+    ctx->queue = queue;
+    ctx->device = device;
+    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof ctx->platform, &ctx->platform, NULL);
+    describe_device(ctx, desc);
+    *out = ctx;
+    return UMBRA_SUCCESS;
+}
+
+void umbra_context_retain(umbra_context ctx)
+{
+    if (ctx)
+        ++ctx->refs;
+}
+
+void umbra_context_release(umbra_context ctx)
+{
+    if (!ctx || --ctx->refs > 0)
+        return;
+    for (umbra__program *p = ctx->programs; p;) {
+        umbra__program *next = p->next;
+        clReleaseProgram(p->program);
+        free(p->key);
+        free(p);
+        p = next;
+    }
+    if (ctx->queue)
+        clReleaseCommandQueue(ctx->queue);
+    if (ctx->cl_ctx)
+        clReleaseContext(ctx->cl_ctx);
+    free(ctx);
+}
+
+const char *umbra_context_device_name(umbra_context ctx) { return ctx ? ctx->device_name : ""; }
+umbra_sampler_kind umbra_context_sampler(umbra_context ctx)
+{
+    return ctx ? ctx->sampler : UMBRA_SAMPLER_BUFFER;
+}
+cl_context umbra_context_cl_context(umbra_context ctx) { return ctx ? ctx->cl_ctx : NULL; }
+cl_device_id umbra_context_cl_device(umbra_context ctx) { return ctx ? ctx->device : NULL; }
+cl_command_queue umbra_context_cl_queue(umbra_context ctx) { return ctx ? ctx->queue : NULL; }
+
+uint64_t umbra__next_id(umbra_context ctx) { return ++ctx->next_id; }
+
+/* ---- programs ------------------------------------------------------------------------------- */
+
+static char *program_key(const char *const *files, size_t nfiles, const char *options)
+{
+    size_t len = strlen(options) + 2;
+    for (size_t i = 0; i < nfiles; ++i)
+        len += strlen(files[i]) + 1;
+    char *key = malloc(len);
+    if (!key)
+        return NULL;
+    key[0] = 0;
+    for (size_t i = 0; i < nfiles; ++i) {
+        strcat(key, files[i]);
+        strcat(key, "+");
+    }
+    strcat(key, "|");
+    strcat(key, options);
+    return key;
+}
+
+umbra_status umbra__program_get(umbra_context ctx, const char *const *files, size_t nfiles,
+                                const char *options, cl_program *out)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    const char *sources[16];
+    char *key = program_key(files, nfiles, options);
+    char *log = NULL;
+    cl_program program = NULL;
+    umbra__program *entry = NULL;
+    if (!key)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra__program_get: out of memory");
+    for (umbra__program *p = ctx->programs; p; p = p->next) {
+        if (strcmp(p->key, key) == 0) {
+            free(key);
+            *out = p->program;
+            return UMBRA_SUCCESS;
+        }
+    }
+    if (nfiles + 1 > sizeof sources / sizeof sources[0]) {
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra__program_get: %zu files", nfiles);
+        goto fail;
+    }
+    sources[0] = umbra__kernel_source("umbra_shared.h");
+    for (size_t i = 0; i < nfiles; ++i) {
+        sources[i + 1] = umbra__kernel_source(files[i]);
+        if (!sources[i + 1] || !sources[0]) {
+            st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                             "umbra__program_get: kernel file '%s' is not embedded", files[i]);
+            goto fail;
+        }
+    }
+    cl_int err;
+    program = clCreateProgramWithSource(ctx->cl_ctx, (cl_uint)(nfiles + 1), sources, NULL, &err);
+    UMBRA_CL_CHECK(err, "clCreateProgramWithSource");
+    err = clBuildProgram(program, 1, &ctx->device, options, NULL, NULL);
+    if (err != CL_SUCCESS) {
+        size_t log_size = 0;
+        clGetProgramBuildInfo(program, ctx->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &log_size);
+        log = calloc(1, log_size + 1);
+        if (log)
+            clGetProgramBuildInfo(program, ctx->device, CL_PROGRAM_BUILD_LOG, log_size, log, NULL);
+        st = umbra__fail(ctx, UMBRA_ERROR_BUILD,
+                         "umbra__program_get: building %s with options '%s' failed with %s (%d); "
+                         "build log:\n%s", key, options, umbra__cl_error_name(err), (int)err,
+                         log ? log : "(unavailable)");
+        goto fail;
+    }
+    entry = calloc(1, sizeof *entry);
+    if (!entry) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra__program_get: out of memory");
+        goto fail;
+    }
+    entry->key = key;
+    entry->program = program;
+    entry->next = ctx->programs;
+    ctx->programs = entry;
+    *out = program;
+    return UMBRA_SUCCESS;
+fail:
+    free(log);
+    free(key);
+    if (program)
+        clReleaseProgram(program);
+    return st;
+}
+
+umbra_status umbra__kernel_create(umbra_context ctx, cl_program program, const char *name,
+                                  cl_kernel *out)
+{
+    cl_int err;
+    *out = clCreateKernel(program, name, &err);
+    if (err != CL_SUCCESS) {
+        *out = NULL;
+        return umbra__fail_cl(ctx, __func__, name, err, __FILE__, __LINE__);
+    }
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__enqueue(umbra_context ctx, cl_kernel k, cl_uint dim, const size_t *global,
+                            const size_t *local, cl_event *event)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    size_t def_local[3] = {64, 1, 1};
+    if (dim == 2) {
+        def_local[0] = 8;
+        def_local[1] = 8;
+    } else if (dim == 3) {
+        def_local[0] = 4;
+        def_local[1] = 4;
+        def_local[2] = 4;
+    }
+    const size_t *l = local ? local : def_local;
+    size_t rounded[3];
+    for (cl_uint i = 0; i < dim; ++i)
+        rounded[i] = (global[i] + l[i] - 1) / l[i] * l[i];
+    UMBRA_CL(clEnqueueNDRangeKernel(ctx->queue, k, dim, NULL, rounded, l, 0, NULL, event));
+fail:
+    return st;
+}
+
+double umbra__event_ms(cl_event ev)
+{
+    cl_ulong a = 0, b = 0;
+    if (!ev || clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_START, sizeof a, &a, NULL) != CL_SUCCESS ||
+        clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_END, sizeof b, &b, NULL) != CL_SUCCESS)
+        return -1.0;
+    return (double)(b - a) * 1e-6;
+}
+
+double umbra__now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}

@@ -1,0 +1,880 @@
+/* host/renderer.c: the renderer front end: validated state, what each change invalidates, and
+ * the frame loop (tables -> shadow structure -> ray caster or the technique's own renderer).
+ *
+ * Nothing is rebuilt per frame unless its inputs changed: step-corrected transfer-function tables
+ * and brick visibility are keyed by (table id, volume id, step); the shadow structure by the full
+ * light key (umbra__light_key); programs by their sources and options (context cache). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+
+static const umbra__technique *const techniques[] = {
+    &umbra__technique_none,
+    &umbra__technique_reference,
+};
+
+static const char *const technique_names[] = {"none", "reference", "threshold", "deep", "cssm",
+                                              "convolution"};
+
+const char *umbra_shadow_technique_name(umbra_shadow_technique t)
+{
+    if ((unsigned)t < sizeof technique_names / sizeof technique_names[0])
+        return technique_names[t];
+    return NULL;
+}
+
+umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out)
+{
+    if (!name || !out)
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    for (unsigned i = 0; i < sizeof technique_names / sizeof technique_names[0]; ++i)
+        if (strcmp(name, technique_names[i]) == 0) {
+            *out = (umbra_shadow_technique)i;
+            return UMBRA_SUCCESS;
+        }
+    return UMBRA_ERROR_INVALID_ARGUMENT;
+}
+
+static const umbra__technique *find_technique(umbra_shadow_technique id)
+{
+    for (size_t i = 0; i < sizeof techniques / sizeof techniques[0]; ++i)
+        if (techniques[i]->id == id)
+            return techniques[i];
+    return NULL;
+}
+
+/* ---- defaults ---------------------------------------------------------------------------------- */
+
+void umbra_render_desc_init(umbra_render_desc *d)
+{
+    if (!d)
+        return;
+    memset(d, 0, sizeof *d);
+    d->struct_size = sizeof *d;
+    d->step = 0.5f;
+    d->termination = 0.99f;
+    d->empty_space_skipping = 1;
+    d->kd = 0.8f;
+    d->ks = 0.3f;
+    d->shininess = 32.0f;
+    d->ambient[0] = d->ambient[1] = d->ambient[2] = 0.2f;
+    d->ground_color[0] = d->ground_color[1] = d->ground_color[2] = 0.8f;
+    d->ground_offset = 0.02f;
+    d->transmission = UMBRA_TRANSMISSION_GREY;
+}
+
+void umbra_shadow_desc_init(umbra_shadow_desc *d)
+{
+    if (!d)
+        return;
+    memset(d, 0, sizeof *d);
+    d->struct_size = sizeof *d;
+    d->technique = UMBRA_SHADOW_NONE;
+    d->reference_step = 0.25f;
+    d->map_size = 1024;
+    d->map_step = 0.5f;
+    d->threshold = 0.5f;
+    d->taps = 13;
+    d->epsilon = 0.02f;
+    d->max_nodes = 0;
+    d->block_size = 8;
+    d->prefilter = 1;
+    d->lookup_table = 1;
+    d->seed = 1;
+    d->slice_distance = 0.5f;
+    d->subsamples = 0;
+    d->preintegrated = 0;
+    d->cone_angle_degrees = 5.0f;
+}
+
+static void normalize3(float v[3])
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f)
+        for (int i = 0; i < 3; ++i)
+            v[i] /= l;
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees)
+{
+    umbra_camera c;
+    memset(&c, 0, sizeof c);
+    float d[3] = {dir[0], dir[1], dir[2]};
+    normalize3(d);
+    if (!(fovy_degrees > 0.0f && fovy_degrees < 180.0f))
+        fovy_degrees = 30.0f;
+    float dist = 0.5f * box_diagonal / sinf(0.5f * fovy_degrees * 3.14159265f / 180.0f) * 1.05f;
+    c.projection = UMBRA_PERSPECTIVE;
+    for (int i = 0; i < 3; ++i)
+        c.eye[i] = d[i] * dist;
+    c.up[1] = 1.0f;
+    if (fabsf(d[1]) > 0.99f) { /* looking straight down or up: y cannot be "up" */
+        c.up[1] = 0.0f;
+        c.up[2] = -1.0f;
+    }
+    c.fovy_degrees = fovy_degrees;
+    c.ortho_height = box_diagonal;
+    return c;
+}
+
+/* ---- lifetime ------------------------------------------------------------------------------------ */
+
+umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
+{
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_renderer_create: out is NULL");
+    *out = NULL;
+    if (!ctx)
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    umbra_renderer r = calloc(1, sizeof *r);
+    if (!r)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_create: out of memory");
+    r->refs = 1;
+    r->ctx = ctx;
+    umbra_context_retain(ctx);
+    umbra_render_desc_init(&r->opts);
+    umbra_shadow_desc_init(&r->shadow);
+    r->tech = &umbra__technique_none;
+    r->light.type = UMBRA_LIGHT_DIRECTIONAL;
+    r->light.direction[0] = -0.5f;
+    r->light.direction[1] = -1.0f;
+    r->light.direction[2] = -0.3f;
+    r->light.color[0] = r->light.color[1] = r->light.color[2] = 1.0f;
+    *out = r;
+    return UMBRA_SUCCESS;
+}
+
+void umbra_renderer_retain(umbra_renderer r)
+{
+    if (r)
+        ++r->refs;
+}
+
+static void release_mem(cl_mem *m)
+{
+    if (*m)
+        clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+static void release_kernels(umbra_renderer r)
+{
+    if (r->render_kernel)
+        clReleaseKernel(r->render_kernel);
+    if (r->query_kernel)
+        clReleaseKernel(r->query_kernel);
+    r->render_kernel = r->query_kernel = NULL;
+    r->program = NULL; /* owned by the context's cache */
+}
+
+static void drop_technique(umbra_renderer r)
+{
+    if (r->tech && r->tech->destroy)
+        r->tech->destroy(r);
+    r->tech_state = NULL;
+    r->built_valid = 0;
+}
+
+void umbra_renderer_release(umbra_renderer r)
+{
+    if (!r || --r->refs > 0)
+        return;
+    drop_technique(r);
+    release_kernels(r);
+    cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
+                      &r->light_tf_buf, &r->view_bricks_buf, &r->light_bricks_buf, &r->out_buf};
+    for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
+        release_mem(mems[i]);
+    umbra_volume_release(r->volume);
+    umbra_transfer_function_release(r->tf);
+    umbra_transfer_function_release(r->light_tf);
+    umbra_context_release(r->ctx);
+    free(r);
+}
+
+/* ---- setters ------------------------------------------------------------------------------------- */
+
+#define CHECK_R(fn)                                                                            \
+    if (!r)                                                                                    \
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+
+umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume)
+{
+    CHECK_R();
+    if (!volume)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_set_volume: volume is NULL");
+    if (volume->ctx != r->ctx)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_set_volume: volume belongs to another context");
+    umbra_volume_retain(volume);
+    umbra_volume_release(r->volume);
+    r->volume = volume;
+    return UMBRA_SUCCESS;
+}
+
+static umbra_status set_tf(umbra_renderer r, umbra_transfer_function tf,
+                           umbra_transfer_function *slot, const char *fn, int allow_null)
+{
+    if (!tf && !allow_null)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: tf is NULL", fn);
+    if (tf && tf->ctx != r->ctx)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: tf belongs to another context", fn);
+    umbra_transfer_function_retain(tf);
+    umbra_transfer_function_release(*slot);
+    *slot = tf;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_set_transfer_function(umbra_renderer r, umbra_transfer_function tf)
+{
+    CHECK_R();
+    return set_tf(r, tf, &r->tf, "umbra_renderer_set_transfer_function", 0);
+}
+
+umbra_status umbra_renderer_set_light_transfer_function(umbra_renderer r,
+                                                        umbra_transfer_function tf)
+{
+    CHECK_R();
+    return set_tf(r, tf, &r->light_tf, "umbra_renderer_set_light_transfer_function", 1);
+}
+
+static int finite3(const float v[3])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+static float len3(const float v[3]) { return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *c)
+{
+    const char *fn = "umbra_renderer_set_camera";
+    CHECK_R();
+    if (!c)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: camera is NULL", fn);
+    if (!finite3(c->eye) || !finite3(c->target) || !finite3(c->up))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: eye, target and up must be finite", fn);
+    float f[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
+    float side[3];
+    cross3(f, c->up, side);
+    if (!(len3(f) > 0.0f) || !(len3(side) > 1e-6f * len3(f) * len3(c->up)))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: eye (%g, %g, %g) and target (%g, %g, %g) must differ and up "
+                           "(%g, %g, %g) must not be parallel to the view direction", fn,
+                           c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1],
+                           c->target[2], c->up[0], c->up[1], c->up[2]);
+    if (c->projection == UMBRA_PERSPECTIVE) {
+        if (!(c->fovy_degrees > 0.0f && c->fovy_degrees < 180.0f))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: fovy_degrees %g must lie in (0, 180)", fn, c->fovy_degrees);
+    } else if (c->projection == UMBRA_ORTHOGRAPHIC) {
+        if (!(c->ortho_height > 0.0f) || !isfinite(c->ortho_height))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: ortho_height %g must be finite and > 0", fn, c->ortho_height);
+    } else {
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: projection %d is unknown",
+                           fn, (int)c->projection);
+    }
+    r->camera = *c;
+    r->camera_set = 1;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *l)
+{
+    const char *fn = "umbra_renderer_set_light";
+    CHECK_R();
+    if (!l)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: light is NULL", fn);
+    if (l->type != UMBRA_LIGHT_POINT && l->type != UMBRA_LIGHT_DIRECTIONAL)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: light type %d is unknown",
+                           fn, (int)l->type);
+    if (!finite3(l->position) || !finite3(l->direction))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: position and direction must be finite", fn);
+    if (l->type == UMBRA_LIGHT_DIRECTIONAL && !(len3(l->direction) > 0.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: directional light direction (0, 0, 0) has no direction", fn);
+    for (int i = 0; i < 3; ++i)
+        if (!(l->color[i] >= 0.0f) || !isfinite(l->color[i]))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: color (%g, %g, %g) must be finite and >= 0", fn, l->color[0],
+                               l->color[1], l->color[2]);
+    r->light = *l;
+    if (l->type == UMBRA_LIGHT_DIRECTIONAL)
+        normalize3(r->light.direction);
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_desc *d)
+{
+    const char *fn = "umbra_renderer_set_options";
+    CHECK_R();
+    if (!d)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", fn);
+    if (d->struct_size != sizeof *d)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->struct_size %zu != %zu: call umbra_render_desc_init", fn,
+                           d->struct_size, sizeof *d);
+    if (!(d->step >= 0.01f && d->step <= 64.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: step %g voxels must lie in [0.01, 64]", fn, d->step);
+    if (!(d->termination > 0.0f && d->termination <= 1.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: termination %g must lie in (0, 1]", fn, d->termination);
+    if (!(d->kd >= 0.0f) || !(d->ks >= 0.0f) || !(d->shininess > 0.0f) || !isfinite(d->kd) ||
+        !isfinite(d->ks) || !isfinite(d->shininess))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: kd %g, ks %g must be >= 0 and shininess %g > 0", fn, d->kd, d->ks,
+                           d->shininess);
+    for (int i = 0; i < 3; ++i)
+        if (!(d->ambient[i] >= 0.0f) || !isfinite(d->ambient[i]) || !(d->ground_color[i] >= 0.0f) ||
+            !isfinite(d->ground_color[i]))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: ambient and ground_color must be finite and >= 0", fn);
+    for (int i = 0; i < 4; ++i)
+        if (!(d->background[i] >= 0.0f) || !isfinite(d->background[i]))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: background channel %d is %g; must be finite and >= 0", fn, i,
+                               d->background[i]);
+    if (!isfinite(d->ground_offset))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ground_offset is %g", fn,
+                           d->ground_offset);
+    if (d->transmission != UMBRA_TRANSMISSION_GREY && d->transmission != UMBRA_TRANSMISSION_COLORED)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: transmission %d is unknown",
+                           fn, (int)d->transmission);
+    r->opts = *d;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *d)
+{
+    const char *fn = "umbra_renderer_set_shadow";
+    CHECK_R();
+    if (!d)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", fn);
+    if (d->struct_size != sizeof *d)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->struct_size %zu != %zu: call umbra_shadow_desc_init", fn,
+                           d->struct_size, sizeof *d);
+    const umbra__technique *t = find_technique(d->technique);
+    if (!t) {
+        const char *name = umbra_shadow_technique_name(d->technique);
+        return umbra__fail(r->ctx, name ? UMBRA_ERROR_UNSUPPORTED : UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: technique %d (%s) is not available in this build", fn,
+                           (int)d->technique, name ? name : "unknown");
+    }
+    if (!(d->reference_step >= 0.01f && d->reference_step <= 64.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: reference_step %g voxels must lie in [0.01, 64]", fn,
+                           d->reference_step);
+    if (t->validate) {
+        umbra_status st = t->validate(r, d);
+        if (st != UMBRA_SUCCESS)
+            return st;
+    }
+    if (t != r->tech) {
+        drop_technique(r);
+        release_kernels(r);
+        r->tech = t;
+    }
+    r->shadow = *d;
+    return UMBRA_SUCCESS;
+}
+
+/* ---- tables ---------------------------------------------------------------------------------------- */
+
+umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_tf ? r->light_tf : r->tf; }
+
+float umbra__voxel_world(umbra_renderer r)
+{
+    const float *s = r->volume->spacing;
+    return fminf(s[0], fminf(s[1], s[2]));
+}
+
+/* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step. */
+static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
+                                    cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    size_t bytes = (size_t)tf->count * 4 * sizeof(float);
+    float *t = malloc(bytes);
+    if (!t)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
+    for (uint32_t i = 0; i < tf->count; ++i) {
+        memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
+        t[4 * i + 3] = 1.0f - powf(1.0f - tf->rgba[4 * i + 3], step_voxels);
+    }
+    release_mem(buf);
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, t, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(corrected transfer function)");
+fail:
+    free(t);
+    return st;
+}
+
+/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
+static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    umbra_volume v = r->volume;
+    size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    unsigned char *flags = malloc(n);
+    if (!flags)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
+    const float last = (float)(tf->count - 1);
+    for (size_t b = 0; b < n; ++b) {
+        int lo = (int)floorf(v->brick_minmax[2 * b] * last);
+        int hi = (int)ceilf(v->brick_minmax[2 * b + 1] * last);
+        lo = lo < 0 ? 0 : lo;
+        hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
+        flags[b] = 0;
+        for (int i = lo; i <= hi && !flags[b]; ++i)
+            flags[b] = tf->rgba[4 * i + 3] > 0.0f;
+    }
+    release_mem(buf);
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n, flags, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(brick table)");
+fail:
+    free(flags);
+    return st;
+}
+
+static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
+                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf)
+{
+    uint32_t bits;
+    memcpy(&bits, &step_voxels, sizeof bits);
+    uint64_t want[3] = {tf->id, r->volume->id, bits};
+    if (*tf_buf && *brick_buf && memcmp(want, key, sizeof want) == 0)
+        return UMBRA_SUCCESS;
+    umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
+    if (st == UMBRA_SUCCESS)
+        st = brick_table(r, tf, brick_buf);
+    if (st == UMBRA_SUCCESS)
+        memcpy(key, want, sizeof want);
+    else
+        memset(key, 0, 3 * sizeof key[0]);
+    return st;
+}
+
+umbra_status umbra__light_tables(umbra_renderer r, float step_voxels)
+{
+    return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf,
+                  &r->light_bricks_buf);
+}
+
+/* ---- per-frame constants ------------------------------------------------------------------------------ */
+
+static void set4(float dst[4], float x, float y, float z, float w)
+{
+    dst[0] = x;
+    dst[1] = y;
+    dst[2] = z;
+    dst[3] = w;
+}
+
+void umbra__frame_update_light(umbra_renderer r)
+{
+    UmbraFrame *F = &r->frame;
+    umbra_volume v = r->volume;
+    float ext[3];
+    for (int a = 0; a < 3; ++a)
+        ext[a] = (float)v->dims[a] * v->spacing[a];
+    set4(F->box_min, -0.5f * ext[0], -0.5f * ext[1], -0.5f * ext[2], 0.0f);
+    set4(F->box_max, 0.5f * ext[0], 0.5f * ext[1], 0.5f * ext[2], 0.0f);
+    set4(F->inv_spacing, 1.0f / v->spacing[0], 1.0f / v->spacing[1], 1.0f / v->spacing[2], 0.0f);
+    for (int a = 0; a < 3; ++a) {
+        F->dims[a] = (int32_t)v->dims[a];
+        F->bricks[a] = (int32_t)v->brick_counts[a];
+    }
+    F->dims[3] = 0;
+    F->bricks[3] = (int32_t)v->brick_size;
+    const umbra_light *l = &r->light;
+    if (l->type == UMBRA_LIGHT_POINT)
+        set4(F->light, l->position[0], l->position[1], l->position[2], 1.0f);
+    else
+        set4(F->light, l->direction[0], l->direction[1], l->direction[2], 0.0f);
+    set4(F->light_color, l->color[0], l->color[1], l->color[2], 0.0f);
+    F->flags &= ~(UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
+    if (l->type == UMBRA_LIGHT_POINT)
+        F->flags |= UMBRA_FLAG_POINT_LIGHT;
+    if (r->opts.transmission == UMBRA_TRANSMISSION_COLORED)
+        F->flags |= UMBRA_FLAG_COLORED;
+    if (r->opts.empty_space_skipping)
+        F->flags |= UMBRA_FLAG_SKIP_EMPTY;
+    F->step_ref = umbra__voxel_world(r);
+    F->light_tf_size = umbra__light_tf(r)->count;
+    r->channels = (r->opts.transmission == UMBRA_TRANSMISSION_GREY ||
+                   umbra_transfer_function_is_grey(umbra__light_tf(r)))
+                      ? 1u
+                      : 3u;
+    r->shadow_params.channels = r->channels;
+}
+
+static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
+{
+    UmbraFrame *F = &r->frame;
+    const umbra_render_desc *o = &r->opts;
+    float ext[3], diag = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        ext[a] = (float)r->volume->dims[a] * r->volume->spacing[a];
+        diag += ext[a] * ext[a];
+    }
+    diag = sqrtf(diag);
+    umbra_camera c = r->camera;
+    if (!r->camera_set) {
+        const float dir[3] = {0.6f, 0.45f, 1.0f};
+        c = umbra_camera_orbit(dir, diag, 30.0f);
+    }
+    float f[3] = {c.target[0] - c.eye[0], c.target[1] - c.eye[1], c.target[2] - c.eye[2]};
+    normalize3(f);
+    float right[3], up[3];
+    cross3(f, c.up, right);
+    normalize3(right);
+    cross3(right, f, up);
+    float aspect = (float)width / (float)height;
+    float half_h = c.projection == UMBRA_ORTHOGRAPHIC
+                       ? 0.5f * c.ortho_height
+                       : tanf(0.5f * c.fovy_degrees * 3.14159265358979f / 180.0f);
+    float half_w = half_h * aspect;
+    set4(F->eye, c.eye[0], c.eye[1], c.eye[2], 0.0f);
+    set4(F->right, right[0] * half_w, right[1] * half_w, right[2] * half_w, 0.0f);
+    set4(F->up, up[0] * half_h, up[1] * half_h, up[2] * half_h, 0.0f);
+    set4(F->forward, f[0], f[1], f[2], 0.0f);
+    set4(F->ambient, o->ambient[0], o->ambient[1], o->ambient[2], 0.0f);
+    set4(F->background, o->background[0], o->background[1], o->background[2], o->background[3]);
+    set4(F->ground_color, o->ground_color[0], o->ground_color[1], o->ground_color[2], 0.0f);
+    float y0 = -0.5f * ext[1] - o->ground_offset * diag;
+    set4(F->ground, 0.0f, 1.0f, 0.0f, -y0);
+    F->width = width;
+    F->height = height;
+    F->seed = o->seed;
+    F->step = o->step * umbra__voxel_world(r);
+    F->termination = o->termination;
+    F->kd = o->kd;
+    F->ks = o->ks;
+    F->shininess = o->shininess;
+    F->tf_size = r->tf->count;
+    uint32_t keep = F->flags & (UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
+    F->flags = keep | (o->jitter ? UMBRA_FLAG_JITTER : 0u) | (o->shading ? UMBRA_FLAG_SHADING : 0u) |
+               (o->ground_plane ? UMBRA_FLAG_GROUND : 0u) |
+               (c.projection == UMBRA_ORTHOGRAPHIC ? UMBRA_FLAG_ORTHO : 0u);
+}
+
+static umbra_status ensure_buffer(umbra_renderer r, cl_mem *buf, size_t bytes, cl_mem_flags flags)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (*buf)
+        return UMBRA_SUCCESS;
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, flags, bytes, NULL, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer");
+fail:
+    return st;
+}
+
+umbra_status umbra__upload_params(umbra_renderer r)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = ensure_buffer(r, &r->frame_buf, sizeof(UmbraFrame), CL_MEM_READ_ONLY);
+    if (st == UMBRA_SUCCESS)
+        st = ensure_buffer(r, &r->shadow_buf, sizeof(UmbraShadow), CL_MEM_READ_ONLY);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->frame_buf, CL_FALSE, 0, sizeof r->frame,
+                                  &r->frame, 0, NULL, NULL));
+    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->shadow_buf, CL_TRUE, 0, sizeof r->shadow_params,
+                                  &r->shadow_params, 0, NULL, NULL));
+fail:
+    return st;
+}
+
+void umbra__build_options(umbra_renderer r, char *buf, size_t size)
+{
+    snprintf(buf, size, "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u",
+             r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels);
+}
+
+umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    cl_mem vol = r->volume->image ? r->volume->image : r->volume->data;
+    cl_mem view_tf = r->view_tf_buf ? r->view_tf_buf : r->light_tf_buf;
+    cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_bricks_buf;
+    cl_mem args[] = {r->frame_buf, vol, view_tf, r->light_tf_buf, view_bricks,
+                     r->light_bricks_buf, r->shadow_buf};
+    for (cl_uint i = 0; i < sizeof args / sizeof args[0]; ++i)
+        UMBRA_CL(clSetKernelArg(k, i, sizeof(cl_mem), &args[i]));
+    *next = (cl_uint)(sizeof args / sizeof args[0]);
+fail:
+    return st;
+}
+
+/* ---- the frame ---------------------------------------------------------------------------------------- */
+
+static umbra_status check_ready(umbra_renderer r, const char *fn)
+{
+    if (!r->volume || !r->tf)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: set a volume and a transfer function first (volume %p, tf %p)", fn,
+                           (void *)r->volume, (void *)r->tf);
+    return UMBRA_SUCCESS;
+}
+
+/* Light tables and the shadow structure, rebuilt only when the light key changed. */
+static umbra_status prepare_shadow(umbra_renderer r)
+{
+    umbra__frame_update_light(r);
+    float light_step = r->tech->light_step ? r->tech->light_step(&r->shadow) : r->shadow.reference_step;
+    umbra_status st = umbra__light_tables(r, light_step);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    umbra__light_key key;
+    memset(&key, 0, sizeof key);
+    key.volume_id = r->volume->id;
+    key.light_tf_id = umbra__light_tf(r)->id;
+    key.light = r->light;
+    key.shadow = r->shadow;
+    key.transmission = r->opts.transmission;
+    key.skip_empty = r->opts.empty_space_skipping;
+    r->stats.shadow_rebuilt = 0;
+    r->stats.shadow_build_ms = 0.0;
+    if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
+        return UMBRA_SUCCESS;
+    r->built_valid = 0;
+    r->shadow_params.step = light_step * umbra__voxel_world(r);
+    st = umbra__upload_params(r);
+    if (st == UMBRA_SUCCESS && r->tech->build)
+        st = r->tech->build(r, &r->stats.shadow_build_ms);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    r->built = key;
+    r->built_valid = 1;
+    r->stats.shadow_rebuilt = 1;
+    return UMBRA_SUCCESS;
+}
+
+static umbra_status ensure_kernels(umbra_renderer r)
+{
+    char options[256];
+    const char *files[] = {"common.cl", "sampling.cl", r->tech->kernel_file, "raycast.cl"};
+    cl_program program;
+    umbra__build_options(r, options, sizeof options);
+    umbra_status st = umbra__program_get(r->ctx, files, 4, options, &program);
+    if (st != UMBRA_SUCCESS || program == r->program)
+        return st;
+    release_kernels(r);
+    st = umbra__kernel_create(r->ctx, program, "raycast_render", &r->render_kernel);
+    if (st == UMBRA_SUCCESS)
+        st = umbra__kernel_create(r->ctx, program, "raycast_query_shadow", &r->query_kernel);
+    if (st != UMBRA_SUCCESS) {
+        release_kernels(r);
+        return st;
+    }
+    r->program = program;
+    return UMBRA_SUCCESS;
+}
+
+static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out)
+{
+    const char *fn = "umbra_renderer_render";
+    umbra_context ctx = r->ctx;
+    umbra_status st = check_ready(r, fn);
+    cl_event ev = NULL;
+    if (st != UMBRA_SUCCESS)
+        return st;
+    st = prepare_shadow(r);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    frame_update_view(r, width, height);
+    r->stats.slices = 0;
+    if (r->tech->render) {
+        st = umbra__upload_params(r);
+        if (st == UMBRA_SUCCESS)
+            st = r->tech->render(r, width, height, out, &r->stats.render_ms);
+        r->stats.samples = 0;
+        return st;
+    }
+    st = ensure_kernels(r);
+    if (st == UMBRA_SUCCESS)
+        st = ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
+    if (st == UMBRA_SUCCESS)
+        st = umbra__upload_params(r);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    cl_ulong zero = 0;
+    cl_uint next = 0;
+    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->samples_buf, CL_FALSE, 0, sizeof zero, &zero, 0,
+                                  NULL, NULL));
+    st = umbra__bind_common(r, r->render_kernel, &next);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &out));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->samples_buf));
+    if (r->tech->bind && (st = r->tech->bind(r, r->render_kernel, next)) != UMBRA_SUCCESS)
+        goto fail;
+    size_t global[2] = {width, height};
+    double t0 = umbra__now_ms();
+    st = umbra__enqueue(ctx, r->render_kernel, 2, global, NULL, &ev);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clWaitForEvents(1, &ev));
+    double ms = umbra__event_ms(ev);
+    r->stats.render_ms = ms >= 0.0 ? ms : umbra__now_ms() - t0;
+    cl_ulong samples = 0;
+    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->samples_buf, CL_TRUE, 0, sizeof samples, &samples,
+                                 0, NULL, NULL));
+    /* Devices without 64-bit atomics count in the low 32 bits only. */
+    r->stats.samples = samples;
+fail:
+    if (ev)
+        clReleaseEvent(ev);
+    return st;
+}
+
+static umbra_status check_size(umbra_renderer r, uint32_t width, uint32_t height, const char *fn)
+{
+    if (width == 0 || height == 0 || width > 16384 || height > 16384)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: size %u x %u must lie in [1, 16384] per side", fn, width, height);
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
+{
+    const char *fn = "umbra_renderer_render";
+    CHECK_R();
+    umbra_context ctx = r->ctx;
+    if (!rgba)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
+    umbra_status st = check_size(r, width, height, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    size_t bytes = (size_t)width * height * 4 * sizeof(float);
+    if (r->out_bytes != bytes)
+        release_mem(&r->out_buf);
+    st = ensure_buffer(r, &r->out_buf, bytes, CL_MEM_WRITE_ONLY);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    r->out_bytes = bytes;
+    st = render_into(r, width, height, r->out_buf);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->out_buf, CL_TRUE, 0, bytes, rgba, 0, NULL, NULL));
+fail:
+    return st;
+}
+
+umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
+                                                cl_mem rgba)
+{
+    const char *fn = "umbra_renderer_render_to_cl_buffer";
+    CHECK_R();
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (!rgba)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
+    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS)
+        return st;
+    size_t have = 0;
+    cl_context owner = NULL;
+    UMBRA_CL(clGetMemObjectInfo(rgba, CL_MEM_SIZE, sizeof have, &have, NULL));
+    UMBRA_CL(clGetMemObjectInfo(rgba, CL_MEM_CONTEXT, sizeof owner, &owner, NULL));
+    if (owner != ctx->cl_ctx)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: buffer belongs to another cl_context", fn);
+    if (have < (size_t)width * height * 16)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: buffer holds %zu bytes; %u x %u RGBA floats need %zu", fn, have,
+                           width, height, (size_t)width * height * 16);
+    clRetainMemObject(rgba);
+    st = render_into(r, width, height, rgba);
+    if (st == UMBRA_SUCCESS)
+        UMBRA_CL(clFinish(ctx->queue));
+    clReleaseMemObject(rgba);
+    return st;
+fail:
+    return st;
+}
+
+umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
+                                         float *rgb)
+{
+    const char *fn = "umbra_renderer_query_shadow";
+    CHECK_R();
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    cl_mem in = NULL, outb = NULL;
+    if (!points || !rgb || count == 0 || count > (1u << 28))
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
+                           fn, (const void *)points, (void *)rgb, count);
+    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS)
+        return st;
+    if (!r->tech->kernel_file)
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique '%s' has no per-point shadow lookup", fn,
+                           umbra_shadow_technique_name(r->tech->id));
+    if ((st = prepare_shadow(r)) != UMBRA_SUCCESS)
+        return st;
+    if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
+        return st;
+    cl_int err;
+    in = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, count * 12,
+                        (void *)points, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(points)");
+    outb = clCreateBuffer(ctx->cl_ctx, CL_MEM_WRITE_ONLY, count * 12, NULL, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(rgb)");
+    if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS)
+        goto fail;
+    cl_uint next = 0, n = (cl_uint)count;
+    if ((st = umbra__bind_common(r, r->query_kernel, &next)) != UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_mem), &in));
+    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_mem), &outb));
+    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_uint), &n));
+    if (r->tech->bind && (st = r->tech->bind(r, r->query_kernel, next)) != UMBRA_SUCCESS)
+        goto fail;
+    size_t global = count;
+    if ((st = umbra__enqueue(ctx, r->query_kernel, 1, &global, NULL, NULL)) != UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
+fail:
+    release_mem(&in);
+    release_mem(&outb);
+    return st;
+}
+
+umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
+{
+    CHECK_R();
+    if (!out)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_get_stats: out is NULL");
+    *out = r->stats;
+    out->light_channels = r->tech->id == UMBRA_SHADOW_NONE ? 0 : r->channels;
+    out->shadow_memory_bytes = r->tech->memory ? r->tech->memory(r) : 0;
+    return UMBRA_SUCCESS;
+}

@@ -1,0 +1,110 @@
+/* host/renderer_internal.h: the renderer's state and the shadow-technique interface.
+ *
+ * A shadow technique is a table of functions (umbra__technique) plus, for per-sample techniques,
+ * a kernels/shadow_<name>.cl file compiled into the ray caster's program (the kernel side of the
+ * interface is described in kernels/shadow_none.cl). To add a technique: write both, add its
+ * table to the list in host/renderer.c, and its name to umbra_shadow_technique. */
+#ifndef UMBRA_RENDERER_INTERNAL_H
+#define UMBRA_RENDERER_INTERNAL_H
+
+#include "internal.h"
+#include "umbra_shared.h"
+
+_Static_assert(sizeof(UmbraFrame) == 13 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
+_Static_assert(sizeof(UmbraShadow) == 32 * 4 + 4 * 4 + 3 * 4 + 7 * 4 + 2 * 4, "UmbraShadow layout");
+
+typedef struct umbra__technique {
+    umbra_shadow_technique id;
+    /* kernels/shadow_<name>.cl, compiled into the ray caster; NULL for a technique that renders
+     * the frame itself (render != NULL). */
+    const char *kernel_file;
+    /* Step, in voxels, of the light pass: the light transfer function is corrected for it. */
+    float (*light_step)(const umbra_shadow_desc *desc);
+    /* Rejects parameters this technique cannot use (optional). */
+    umbra_status (*validate)(umbra_renderer r, const umbra_shadow_desc *desc);
+    /* (Re)builds the shadow structure for the renderer's current light inputs; adds device time
+     * to *ms. Called only when the light, volume, light transfer function or shadow description
+     * changed since the last build (optional). */
+    umbra_status (*build)(umbra_renderer r, double *ms);
+    /* Sets the technique's extra kernel arguments, starting at index first (optional). */
+    umbra_status (*bind)(umbra_renderer r, cl_kernel k, cl_uint first);
+    /* Renders the whole frame into out instead of the ray caster (optional). */
+    umbra_status (*render)(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out,
+                           double *ms);
+    /* Device bytes held by the shadow structure (optional: 0). */
+    size_t (*memory)(umbra_renderer r);
+    /* Frees r->tech_state (optional). */
+    void (*destroy)(umbra_renderer r);
+} umbra__technique;
+
+/* What a shadow structure depends on; a change of any field means a rebuild. */
+typedef struct umbra__light_key {
+    uint64_t volume_id, light_tf_id;
+    umbra_light light;
+    umbra_shadow_desc shadow;
+    umbra_transmission transmission;
+    int skip_empty;
+} umbra__light_key;
+
+struct umbra_renderer_t {
+    int refs;
+    umbra_context ctx;
+    umbra_volume volume;
+    umbra_transfer_function tf, light_tf;   /* light_tf NULL: the view tf */
+    umbra_camera camera;
+    int camera_set;
+    umbra_light light;
+    umbra_render_desc opts;
+    umbra_shadow_desc shadow;
+    const umbra__technique *tech;
+    void *tech_state;                        /* owned by the technique */
+
+    UmbraFrame frame;                        /* host copy of the per-frame constants */
+    UmbraShadow shadow_params;               /* host copy, filled by the renderer + technique */
+    uint32_t channels;                       /* light channels simulated: 1 or 3 */
+
+    /* device resources, re-created only when their inputs change */
+    cl_mem frame_buf, shadow_buf, samples_buf;
+    cl_mem view_tf_buf, light_tf_buf;        /* tables with step-corrected alpha */
+    cl_mem view_bricks_buf, light_bricks_buf;/* uchar per brick: nonzero if visible */
+    uint64_t view_tf_key[3], light_tf_key[3];/* (tf id, volume id, step bits) they were made for */
+    umbra__light_key built;                  /* inputs of the current shadow structure */
+    int built_valid;
+    cl_mem out_buf;
+    size_t out_bytes;
+    cl_program program;                      /* the ray caster + technique program in use */
+    cl_kernel render_kernel, query_kernel;
+
+    umbra_render_stats stats;
+};
+
+/* The light transfer function in effect (the view one unless a light one was set). */
+umbra_transfer_function umbra__light_tf(umbra_renderer r);
+
+/* World units of one voxel step (the smallest spacing). */
+float umbra__voxel_world(umbra_renderer r);
+
+/* Fills r->frame's volume and light fields from the current state (the camera part is filled at
+ * render time). Techniques may rely on it during build. */
+void umbra__frame_update_light(umbra_renderer r);
+
+/* Makes sure r->light_tf_buf holds the light table corrected for step_voxels and
+ * r->light_bricks_buf the visibility of each brick under it. */
+umbra_status umbra__light_tables(umbra_renderer r, float step_voxels);
+
+/* Uploads r->frame and r->shadow_params to the device. */
+umbra_status umbra__upload_params(umbra_renderer r);
+
+/* The OpenCL build options every program of this renderer uses: the sampler and the number of
+ * light channels. */
+void umbra__build_options(umbra_renderer r, char *buf, size_t size);
+
+/* Sets the arguments the ray caster and every light-space kernel share, in this order:
+ * frame, volume, view tf, light tf, view bricks, light bricks, shadow params. Returns the next
+ * free index through *next. */
+umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next);
+
+extern const umbra__technique umbra__technique_none;
+extern const umbra__technique umbra__technique_reference;
+
+#endif

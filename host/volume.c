@@ -1,0 +1,238 @@
+/* host/volume.c: uploading a scalar volume and its empty-space-skipping brick table.
+ *
+ * Voxels are normalised to [0,1] through the value range and stored as float32, in a buffer (for
+ * the buffer sampler) or a CL_R/CL_FLOAT 3D image (image sampler). Each brick keeps the min and
+ * max normalised value over the voxels its trilinear footprint reads (its own and the next layer),
+ * so a brick whose whole range maps to zero opacity can be skipped without changing a pixel. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+size_t umbra_scalar_type_size(umbra_scalar_type type)
+{
+    switch (type) {
+    case UMBRA_UINT8: return 1;
+    case UMBRA_UINT16: return 2;
+    case UMBRA_INT16: return 2;
+    case UMBRA_FLOAT32: return 4;
+    }
+    return 0;
+}
+
+void umbra_volume_desc_init(umbra_volume_desc *desc)
+{
+    if (!desc)
+        return;
+    memset(desc, 0, sizeof *desc);
+    desc->struct_size = sizeof *desc;
+    desc->type = UMBRA_UINT8;
+    desc->spacing[0] = desc->spacing[1] = desc->spacing[2] = 1.0f;
+    desc->brick_size = 16;
+}
+
+static float voxel_at(const void *data, umbra_scalar_type type, size_t i)
+{
+    switch (type) {
+    case UMBRA_UINT8: return (float)((const uint8_t *)data)[i];
+    case UMBRA_UINT16: return (float)((const uint16_t *)data)[i];
+    case UMBRA_INT16: return (float)((const int16_t *)data)[i];
+    case UMBRA_FLOAT32: return ((const float *)data)[i];
+    }
+    return 0.0f;
+}
+
+static umbra_status validate(umbra_context ctx, const umbra_volume_desc *d)
+{
+    const char *fn = "umbra_volume_create";
+    if (d->struct_size != sizeof *d)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->struct_size %zu != %zu: call umbra_volume_desc_init", fn,
+                           d->struct_size, sizeof *d);
+    if (!d->data)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc->data is NULL", fn);
+    if (umbra_scalar_type_size(d->type) == 0)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: scalar type %d is unknown", fn,
+                           (int)d->type);
+    if (d->dims[0] == 0 || d->dims[1] == 0 || d->dims[2] == 0)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: dims %u x %u x %u: every size must be > 0", fn, d->dims[0],
+                           d->dims[1], d->dims[2]);
+    if ((uint64_t)d->dims[0] * d->dims[1] * d->dims[2] > ((uint64_t)1 << 32))
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: dims %u x %u x %u: more than 2^32 voxels", fn, d->dims[0],
+                           d->dims[1], d->dims[2]);
+    for (int a = 0; a < 3; ++a)
+        if (!(d->spacing[a] > 0.0f) || !isfinite(d->spacing[a]))
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: spacing %g x %g x %g: every spacing must be finite and > 0", fn,
+                               d->spacing[0], d->spacing[1], d->spacing[2]);
+    if (d->value_range_given &&
+        (!isfinite(d->value_min) || !isfinite(d->value_max) || !(d->value_max > d->value_min)))
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: value range [%g, %g] must be finite with max > min", fn,
+                           d->value_min, d->value_max);
+    if (d->brick_size < 2 || d->brick_size > 256)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: brick_size %u must lie in [2, 256]", fn, d->brick_size);
+    return UMBRA_SUCCESS;
+}
+
+/* Min/max over each brick's footprint: voxels [b*B, (b+1)*B] per axis, clamped to the grid. */
+static void compute_bricks(umbra_volume v, const float *vox)
+{
+    const uint32_t B = v->brick_size;
+    const uint32_t *n = v->dims, *nb = v->brick_counts;
+    for (uint32_t bz = 0; bz < nb[2]; ++bz)
+        for (uint32_t by = 0; by < nb[1]; ++by)
+            for (uint32_t bx = 0; bx < nb[0]; ++bx) {
+                float lo = FLT_MAX, hi = -FLT_MAX;
+                uint32_t z1 = bz * B + B < n[2] - 1 ? bz * B + B : n[2] - 1;
+                uint32_t y1 = by * B + B < n[1] - 1 ? by * B + B : n[1] - 1;
+                uint32_t x1 = bx * B + B < n[0] - 1 ? bx * B + B : n[0] - 1;
+                for (uint32_t z = bz * B; z <= z1; ++z)
+                    for (uint32_t y = by * B; y <= y1; ++y) {
+                        const float *row = vox + ((size_t)z * n[1] + y) * n[0];
+                        for (uint32_t x = bx * B; x <= x1; ++x) {
+                            lo = row[x] < lo ? row[x] : lo;
+                            hi = row[x] > hi ? row[x] : hi;
+                        }
+                    }
+                size_t i = ((size_t)bz * nb[1] + by) * nb[0] + bx;
+                v->brick_minmax[2 * i] = lo;
+                v->brick_minmax[2 * i + 1] = hi;
+            }
+}
+
+umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
+                                 umbra_volume *out)
+{
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_volume_create: out is NULL");
+    *out = NULL;
+    if (!ctx || !desc)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_volume_create: ctx %p, desc %p: neither may be NULL",
+                           (void *)ctx, (void *)desc);
+    umbra_status st = validate(ctx, desc);
+    if (st != UMBRA_SUCCESS)
+        return st;
+
+    float *vox = NULL;
+    umbra_volume v = calloc(1, sizeof *v);
+    const size_t count = (size_t)desc->dims[0] * desc->dims[1] * desc->dims[2];
+    if (!v)
+        goto oom;
+    v->refs = 1;
+    v->ctx = ctx;
+    umbra_context_retain(ctx);
+    memcpy(v->dims, desc->dims, sizeof v->dims);
+    memcpy(v->spacing, desc->spacing, sizeof v->spacing);
+    v->brick_size = desc->brick_size;
+    for (int a = 0; a < 3; ++a)
+        v->brick_counts[a] = (v->dims[a] + v->brick_size - 1) / v->brick_size;
+    v->id = umbra__next_id(ctx);
+
+    float lo = desc->value_min, hi = desc->value_max;
+    if (!desc->value_range_given) {
+        lo = FLT_MAX;
+        hi = -FLT_MAX;
+        for (size_t i = 0; i < count; ++i) {
+            float x = voxel_at(desc->data, desc->type, i);
+            if (!isfinite(x)) {
+                st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                 "umbra_volume_create: voxel %zu is %g; float volumes must be finite",
+                                 i, x);
+                goto fail;
+            }
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+        }
+        if (!(hi > lo))
+            hi = lo + 1.0f; /* a constant volume maps to 0 */
+    }
+    v->value_min = lo;
+    v->value_max = hi;
+
+    vox = malloc(count * sizeof *vox);
+    size_t nbricks = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    v->brick_minmax = malloc(2 * nbricks * sizeof *v->brick_minmax);
+    if (!vox || !v->brick_minmax)
+        goto oom;
+    const float scale = 1.0f / (hi - lo);
+    for (size_t i = 0; i < count; ++i) {
+        float x = (voxel_at(desc->data, desc->type, i) - lo) * scale;
+        vox[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : (x == x ? x : 0.0f));
+    }
+    compute_bricks(v, vox);
+
+    cl_int err;
+    if (ctx->sampler == UMBRA_SAMPLER_IMAGE) {
+        cl_image_format fmt = {CL_R, CL_FLOAT};
+        cl_image_desc idesc;
+        memset(&idesc, 0, sizeof idesc);
+        idesc.image_type = CL_MEM_OBJECT_IMAGE3D;
+        idesc.image_width = v->dims[0];
+        idesc.image_height = v->dims[1];
+        idesc.image_depth = v->dims[2];
+        v->image = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, &fmt, &idesc,
+                                 vox, &err);
+        UMBRA_CL_CHECK(err, "clCreateImage(volume)");
+    } else {
+        v->data = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                 count * sizeof *vox, vox, &err);
+        UMBRA_CL_CHECK(err, "clCreateBuffer(volume)");
+    }
+    v->device_bytes = count * sizeof *vox;
+    free(vox);
+    *out = v;
+    return UMBRA_SUCCESS;
+oom:
+    st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                     "umbra_volume_create: out of host memory for %u x %u x %u voxels",
+                     desc->dims[0], desc->dims[1], desc->dims[2]);
+fail:
+    free(vox);
+    umbra_volume_release(v);
+    return st;
+}
+
+umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
+{
+    if (!v || !out)
+        return umbra__fail(v ? v->ctx : NULL, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_volume_get_info: volume %p, out %p: neither may be NULL",
+                           (void *)v, (void *)out);
+    for (int a = 0; a < 3; ++a) {
+        out->dims[a] = v->dims[a];
+        out->spacing[a] = v->spacing[a];
+        out->extent[a] = (float)v->dims[a] * v->spacing[a];
+        out->brick_counts[a] = v->brick_counts[a];
+    }
+    out->value_min = v->value_min;
+    out->value_max = v->value_max;
+    out->brick_size = v->brick_size;
+    out->device_bytes = v->device_bytes;
+    return UMBRA_SUCCESS;
+}
+
+void umbra_volume_retain(umbra_volume v)
+{
+    if (v)
+        ++v->refs;
+}
+
+void umbra_volume_release(umbra_volume v)
+{
+    if (!v || --v->refs > 0)
+        return;
+    if (v->data)
+        clReleaseMemObject(v->data);
+    if (v->image)
+        clReleaseMemObject(v->image);
+    free(v->brick_minmax);
+    umbra_context_release(v->ctx);
+    free(v);
+}

@@ -1,0 +1,176 @@
+/* umbra/renderer.h: direct volume rendering with shadows.
+ *
+ * A renderer draws one volume with a view transfer function from a camera, lit by one light, and
+ * takes a per-sample RGB shadow factor from the selected shadow technique. Setters copy their
+ * arguments and mark what changed; render() rebuilds only what the change calls for (moving the
+ * camera re-uses a shadow map built for the same light, volume and light transfer function).
+ *
+ * Shading model, shared by every technique. A sample of (step-corrected) opacity a and
+ * transmission colour t passes the fraction 1 - a (1 - t_c) of light channel c (the CSSM paper's
+ * rho = a (1 - t)). The shadow factor S_c at a point is the product of these fractions along the
+ * path to the light. t is 0 in UMBRA_TRANSMISSION_GREY mode (classic grey shadows) or the RGB of
+ * the light transfer function in UMBRA_TRANSMISSION_COLORED mode (coloured shadows: red material
+ * lets red light through). A sample of colour c is then lit as
+ *     c * (ambient + light * S * (shading ? kd |N.L| : 1)) + (shading ? light * S * ks |N.H|^n : 0)
+ * and composited front to back (emission-absorption, Max 1995). The ground plane is lit as
+ *     ground * (ambient + light * S * max(0, N.L)). */
+#ifndef UMBRA_RENDERER_H
+#define UMBRA_RENDERER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "umbra/context.h"
+#include "umbra/transfer_function.h"
+#include "umbra/volume.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct umbra_renderer_t *umbra_renderer;
+
+typedef enum umbra_projection {
+    UMBRA_PERSPECTIVE = 0,
+    UMBRA_ORTHOGRAPHIC = 1
+} umbra_projection;
+
+/* A look-at camera in world space (the volume's box is centred on the origin). */
+typedef struct umbra_camera {
+    umbra_projection projection;
+    float eye[3];
+    float target[3];
+    float up[3];
+    float fovy_degrees;   /* perspective: vertical field of view, in (0, 180) */
+    float ortho_height;   /* orthographic: height of the view in world units, > 0 */
+} umbra_camera;
+
+/* A camera looking at the volume's centre from direction dir (need not be normalised) at a
+ * distance that frames a box of the given diagonal. */
+umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees);
+
+typedef enum umbra_light_type {
+    UMBRA_LIGHT_POINT = 0,
+    UMBRA_LIGHT_DIRECTIONAL = 1
+} umbra_light_type;
+
+typedef struct umbra_light {
+    umbra_light_type type;
+    float position[3];   /* point light, world space; may lie inside the volume */
+    float direction[3];  /* directional light: the direction light travels in (need not be unit) */
+    float color[3];      /* RGB intensity, each >= 0 */
+} umbra_light;
+
+typedef enum umbra_transmission {
+    UMBRA_TRANSMISSION_GREY = 0,    /* t = 0: every channel attenuated by the opacity alone */
+    UMBRA_TRANSMISSION_COLORED = 1  /* t = RGB of the light transfer function */
+} umbra_transmission;
+
+typedef struct umbra_render_desc {
+    size_t struct_size;      /* sizeof(umbra_render_desc); set by umbra_render_desc_init */
+    float step;              /* sampling step along view rays, in voxels (default 0.5) */
+    int jitter;              /* nonzero: start each ray at a seeded random fraction of a step */
+    uint32_t seed;           /* seed for the jitter (and stochastic techniques) */
+    float termination;       /* early ray termination once accumulated opacity exceeds this
+                                (default 0.99; 1 disables it) */
+    int empty_space_skipping;/* nonzero (default): skip bricks the transfer function makes empty */
+    int shading;             /* nonzero: gradient Blinn-Phong local shading (default 0) */
+    float kd, ks, shininess; /* Blinn-Phong coefficients (defaults 0.8, 0.3, 32) */
+    float ambient[3];        /* ambient light (default 0.2 each) */
+    float background[4];     /* premultiplied RGBA behind everything (default 0,0,0,0) */
+    int ground_plane;        /* nonzero: opaque plane under the volume receives shadows */
+    float ground_color[3];   /* default 0.8 each */
+    float ground_offset;     /* gap between the box's lowest y and the plane, as a fraction of
+                                the box diagonal (default 0.02; negative lifts it into the box) */
+    umbra_transmission transmission; /* default UMBRA_TRANSMISSION_GREY */
+} umbra_render_desc;
+
+void umbra_render_desc_init(umbra_render_desc *desc);
+
+typedef enum umbra_shadow_technique {
+    UMBRA_SHADOW_NONE = 0,       /* shadow factor 1 everywhere */
+    UMBRA_SHADOW_REFERENCE = 1,  /* exact: a shadow ray marched from every sample */
+    UMBRA_SHADOW_THRESHOLD = 2,  /* opacity-threshold shadow map */
+    UMBRA_SHADOW_DEEP = 3,       /* deep shadow map (Hadwiger et al. 2006) */
+    UMBRA_SHADOW_CSSM = 4,       /* colored stochastic shadow map (Weidner & Linsen) */
+    UMBRA_SHADOW_CONVOLUTION = 5 /* slice-based convolution shadows (ICS / SCS) */
+} umbra_shadow_technique;
+
+/* Name used by the CLI ("reference"), or NULL for an unknown value. */
+const char *umbra_shadow_technique_name(umbra_shadow_technique technique);
+/* Parses a name; UMBRA_ERROR_INVALID_ARGUMENT for an unknown one. */
+umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
+
+typedef struct umbra_shadow_desc {
+    size_t struct_size;          /* sizeof(umbra_shadow_desc); set by umbra_shadow_desc_init */
+    umbra_shadow_technique technique; /* default UMBRA_SHADOW_NONE */
+    /* reference */
+    float reference_step;        /* shadow-ray step in voxels (default 0.25) */
+    /* light-space maps */
+    uint32_t map_size;           /* map resolution, map_size^2 texels (default 1024) */
+    float map_step;              /* light-ray step in voxels (default 0.5) */
+    float threshold;             /* threshold map: accumulated opacity (default 0.5) */
+    uint32_t taps;               /* CSSM / filtered threshold: 1, 7, 13 or 21 (default 13) */
+    float epsilon;               /* deep map: compression error bound (default 0.02) */
+    uint32_t max_nodes;          /* deep map: fixed node budget per channel, 0 = unbounded */
+    uint32_t block_size;         /* deep map: node layers per block (default 8) */
+    uint32_t prefilter;          /* deep map: sub-pixel rays per texel, 1 or 5 (default 1) */
+    int lookup_table;            /* deep map: use the pre-compressed segment table (default 1) */
+    uint32_t seed;               /* CSSM random stream (default 1) */
+    /* convolution */
+    float slice_distance;        /* voxels (default 0.5) */
+    uint32_t subsamples;         /* SCS sub-samples between slices (default 0) */
+    int preintegrated;           /* nonzero: pre-integrated attenuation (default 0) */
+    float cone_angle_degrees;    /* convolution kernel half-angle (default 5) */
+} umbra_shadow_desc;
+
+void umbra_shadow_desc_init(umbra_shadow_desc *desc);
+
+/* Creates a renderer on ctx (retained). */
+umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out);
+void umbra_renderer_retain(umbra_renderer r);
+void umbra_renderer_release(umbra_renderer r); /* NULL is a no-op */
+
+/* The volume and transfer functions are retained. The light transfer function drives the light
+ * pass (and the transmission colour); NULL (the default) uses the view transfer function. */
+umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume);
+umbra_status umbra_renderer_set_transfer_function(umbra_renderer r, umbra_transfer_function tf);
+umbra_status umbra_renderer_set_light_transfer_function(umbra_renderer r,
+                                                        umbra_transfer_function tf);
+/* Camera, light, options and shadow descriptions are copied and validated. */
+umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *camera);
+umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *light);
+umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_desc *desc);
+umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *desc);
+
+/* Renders width x height premultiplied RGBA floats, row 0 at the top, into rgba (4*w*h floats,
+ * borrowed). Blocks until done. */
+umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height,
+                                   float *rgba);
+
+/* Renders into the application's buffer (retained during the call; at least 16*w*h bytes, same
+ * layout as above). Blocks until done. */
+umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
+                                                cl_mem rgba);
+
+/* Evaluates the current technique's shadow factor at count world-space points (3 floats each,
+ * borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
+umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
+                                         float *rgb);
+
+typedef struct umbra_render_stats {
+    double shadow_build_ms;      /* device time of the last shadow build (0 if it was reused) */
+    double render_ms;            /* device time of the last render */
+    int shadow_rebuilt;          /* nonzero if the last render rebuilt the shadow structure */
+    size_t shadow_memory_bytes;  /* device memory the shadow structure holds */
+    uint32_t light_channels;     /* 1 or 3: light channels the technique simulates */
+    uint32_t slices;             /* convolution: slices in the last frame, else 0 */
+    uint64_t samples;            /* view samples taken in the last render (skipped ones excluded) */
+} umbra_render_stats;
+
+umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

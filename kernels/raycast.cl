@@ -1,0 +1,145 @@
+/* kernels/raycast.cl: the view-space ray caster.
+ *
+ * Front-to-back emission-absorption compositing (Max 1995) with early ray termination,
+ * empty-space skipping over bricks the view transfer function leaves empty, a seeded jittered
+ * start, optional Blinn-Phong shading, and an optional opaque ground plane. Every sample with
+ * non-zero opacity, and every ground-plane hit, takes its RGB shadow factor from the shadow
+ * technique compiled into this program (see kernels/shadow_none.cl for the interface). The host's
+ * plain-C twin, tests/reference/cpu_reference.c, follows this file step for step. */
+
+#if defined(cl_khr_int64_base_atomics)
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+#define UMBRA_COUNT_T ulong
+#define UMBRA_COUNT_ADD(p, v) atom_add((p), (ulong)(v))
+#else
+#define UMBRA_COUNT_T uint
+#define UMBRA_COUNT_ADD(p, v) atomic_add((p), (uint)(v))
+#endif
+
+/* Light arriving at a sample of colour c (alpha ignored) with shadow factor s. */
+inline float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, float3 p, float3 view,
+                           float3 grad)
+{
+    float3 light = F3(F->light_color) * s;
+    float3 amb = F3(F->ambient);
+    if (!(F->flags & UMBRA_FLAG_SHADING))
+        return c * (amb + light);
+    float gl = length(grad);
+    if (!(gl > 1e-6f))
+        return c * (amb + light);
+    float3 n = -grad / gl;
+    float3 l = to_light(F, p).xyz;
+    float3 hv = normalize(l + view);
+    float diff = fabs(dot(n, l));
+    float spec = pow(fabs(dot(n, hv)), F->shininess);
+    return c * (amb + light * F->kd * diff) + light * F->ks * spec;
+}
+
+/* The view ray through pixel (px, py): origin and unit direction. */
+inline void camera_ray(__global const UmbraFrame *F, int px, int py, float3 *o, float3 *d)
+{
+    float sx = ((float)px + 0.5f) / (float)F->width * 2.0f - 1.0f;
+    float sy = 1.0f - ((float)py + 0.5f) / (float)F->height * 2.0f;
+    if (F->flags & UMBRA_FLAG_ORTHO) {
+        *o = F3(F->eye) + sx * F3(F->right) + sy * F3(F->up);
+        *d = F3(F->forward);
+    } else {
+        *o = F3(F->eye);
+        *d = normalize(F3(F->forward) + sx * F3(F->right) + sy * F3(F->up));
+    }
+}
+
+__kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
+                             __global const float4 *view_tf, __global const float4 *light_tf,
+                             __global const uchar *view_bricks, __global const uchar *light_bricks,
+                             __global const UmbraShadow *S, __global float4 *out,
+                             __global UMBRA_COUNT_T *samples SHADOW_KERNEL_PARAMS)
+{
+    const int px = get_global_id(0), py = get_global_id(1);
+    if (px >= (int)F->width || py >= (int)F->height)
+        return;
+    const VolGeom g = vol_geom(F);
+    const uint flags = F->flags;
+    float3 o, d;
+    camera_ray(F, px, py, &o, &d);
+
+    /* The ground plane n.x + w = 0 ends the ray where it is hit from above. */
+    float t_ground = UMBRA_INF;
+    if (flags & UMBRA_FLAG_GROUND) {
+        float3 n = F3(F->ground);
+        float dn = dot(n, d);
+        float tg = -(dot(n, o) + F->ground[3]) / dn;
+        if (dn < 0.0f && tg > 0.0f)
+            t_ground = tg;
+    }
+
+    float3 color = (float3)(0.0f);
+    float alpha = 0.0f;
+    uint taken = 0;
+    ShadowRay sr;
+    shadow_ray_init(&sr);
+    float2 tb = ray_box(o, d, g.box_min, g.box_max);
+    float t0 = fmax(tb.x, 0.0f);
+    float t1 = fmin(tb.y, t_ground);
+    if (t1 > t0) {
+        const float h = F->step;
+        const float jitter = (flags & UMBRA_FLAG_JITTER) ? umbra_random(F->seed, px, py, 0u) : 0.0f;
+        const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+        const int n = (int)ceil((t1 - t0) / h - jitter);
+        for (int k = 0; k < n;) {
+            float t = t0 + ((float)k + jitter) * h;
+            float3 p = o + t * d;
+            if (skip && !view_bricks[brick_index(g, p)]) {
+                k = next_sample_after(t0, h, jitter, brick_exit(g, o, d, t), k);
+                continue;
+            }
+            ++taken;
+            float4 c = tf_lookup(view_tf, F->tf_size, sample_volume(vol, g, p));
+            if (c.w > 0.0f) {
+                float3 s = SHADOW_FACTOR(sr, p);
+                float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p)
+                                                            : (float3)(0.0f);
+                float3 lit = shade_sample(F, c.xyz, s, p, -d, grad);
+                color += (1.0f - alpha) * c.w * lit;
+                alpha += (1.0f - alpha) * c.w;
+                if (alpha > F->termination)
+                    break;
+            }
+            ++k;
+        }
+    }
+
+    if (t_ground < UMBRA_INF && alpha <= F->termination) {
+        float3 p = o + t_ground * d;
+        float3 s = SHADOW_FACTOR(sr, p);
+        float ndl = fmax(dot(F3(F->ground), to_light(F, p).xyz), 0.0f);
+        float3 lit = F3(F->ground_color) * (F3(F->ambient) + F3(F->light_color) * s * ndl);
+        color += (1.0f - alpha) * lit;
+        alpha = 1.0f;
+    }
+    float4 bg = vload4(0, F->background);
+    out[py * (int)F->width + px] = (float4)(color, alpha) + (1.0f - alpha) * bg;
+    if (taken)
+        UMBRA_COUNT_ADD(samples, taken);
+}
+
+/* Evaluates the shadow factor at arbitrary world points: for tests, and for applications that
+ * shade their own geometry with umbra's shadows. */
+__kernel void raycast_query_shadow(__global const UmbraFrame *F, VOLUME_PARAM,
+                                   __global const float4 *view_tf, __global const float4 *light_tf,
+                                   __global const uchar *view_bricks,
+                                   __global const uchar *light_bricks,
+                                   __global const UmbraShadow *S, __global const float *points,
+                                   __global float *rgb, uint count SHADOW_KERNEL_PARAMS)
+{
+    const uint i = get_global_id(0);
+    if (i >= count)
+        return;
+    (void)view_tf;
+    (void)view_bricks;
+    const VolGeom g = vol_geom(F);
+    ShadowRay sr;
+    shadow_ray_init(&sr);
+    float3 p = vload3(i, points);
+    vstore3(SHADOW_FACTOR(sr, p), i, rgb);
+}

@@ -1,0 +1,52 @@
+/* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
+ * build time (UMBRA_SAMPLER_IMAGE): a float buffer with hand-written trilinear interpolation
+ * (fastest on PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture
+ * hardware on GPUs). Both clamp to the border voxels and put voxel centres at integer voxel
+ * coordinates, so they agree to the filtering hardware's precision. */
+
+#ifndef UMBRA_SAMPLER_IMAGE
+#define UMBRA_SAMPLER_IMAGE 0
+#endif
+
+#if UMBRA_SAMPLER_IMAGE
+#define VOLUME_PARAM __read_only image3d_t vol
+__constant sampler_t umbra_linear =
+    CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_CLAMP_TO_EDGE | CLK_FILTER_LINEAR;
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 u = (p - g.box_min) / (g.box_max - g.box_min);
+    return read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x;
+}
+#else
+#define VOLUME_PARAM __global const float *restrict vol
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    float3 fl = floor(x);
+    float3 f = x - fl;
+    int3 i0 = convert_int3(fl);
+    int3 i1 = min(i0 + 1, g.dims - 1);
+    size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+    size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
+    size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
+    float c000 = vol[z0 + y0 + i0.x], c100 = vol[z0 + y0 + i1.x];
+    float c010 = vol[z0 + y1 + i0.x], c110 = vol[z0 + y1 + i1.x];
+    float c001 = vol[z1 + y0 + i0.x], c101 = vol[z1 + y0 + i1.x];
+    float c011 = vol[z1 + y1 + i0.x], c111 = vol[z1 + y1 + i1.x];
+    float c00 = mix(c000, c100, f.x), c10 = mix(c010, c110, f.x);
+    float c01 = mix(c001, c101, f.x), c11 = mix(c011, c111, f.x);
+    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+}
+#endif
+
+/* Central-difference gradient, one voxel each way, in value per world unit. */
+inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 s = g.spacing;
+    float gx = sample_volume(vol, g, p + (float3)(s.x, 0, 0)) - sample_volume(vol, g, p - (float3)(s.x, 0, 0));
+    float gy = sample_volume(vol, g, p + (float3)(0, s.y, 0)) - sample_volume(vol, g, p - (float3)(0, s.y, 0));
+    float gz = sample_volume(vol, g, p + (float3)(0, 0, s.z)) - sample_volume(vol, g, p - (float3)(0, 0, s.z));
+    return (float3)(gx, gy, gz) * 0.5f * g.inv_spacing;
+}

@@ -1,0 +1,74 @@
+/* kernels/umbra_shared.h: structs shared by the host and the kernels.
+ *
+ * This file is compiled twice: as C by the host (the host modules include it) and as OpenCL C, prepended
+ * to every program. Only fixed-width scalars and arrays of them appear here, so the layout is the
+ * same on both sides; the host checks the sizes with _Static_assert. Vectors are stored as
+ * float[4] and read in kernels with the F3() macro. */
+#ifndef UMBRA_SHARED_H
+#define UMBRA_SHARED_H
+
+#ifdef __OPENCL_VERSION__
+typedef uint uint32_t;
+typedef int int32_t;
+#define F3(a) ((float3)((a)[0], (a)[1], (a)[2]))
+#else
+#include <stdint.h>
+#endif
+
+/* Flags in UmbraFrame.flags. */
+#define UMBRA_FLAG_JITTER 1u
+#define UMBRA_FLAG_SKIP_EMPTY 2u
+#define UMBRA_FLAG_SHADING 4u
+#define UMBRA_FLAG_GROUND 8u
+#define UMBRA_FLAG_ORTHO 16u
+#define UMBRA_FLAG_COLORED 32u
+#define UMBRA_FLAG_POINT_LIGHT 64u
+
+/* Everything one view-space frame needs: camera, volume geometry, light and shading. World space
+ * has the volume's box centred on the origin; "voxel coordinates" put voxel i's centre at i. */
+typedef struct UmbraFrame {
+    float eye[4];          /* camera position (perspective) or view-plane centre (ortho) */
+    float right[4];        /* image-plane x axis, scaled to half the view width at distance 1 */
+    float up[4];           /* image-plane y axis, scaled to half the view height at distance 1 */
+    float forward[4];      /* unit viewing direction */
+    float box_min[4];      /* world-space box of the volume: -extent/2 */
+    float box_max[4];      /* +extent/2 */
+    float inv_spacing[4];  /* 1 / spacing: world -> voxel units */
+    float light[4];        /* point light position, or directional light's unit travel direction */
+    float light_color[4];
+    float ambient[4];
+    float background[4];
+    float ground_color[4];
+    float ground[4];       /* ground plane n.x + d = 0 as (n, d), n unit, facing +y */
+    int32_t dims[4];       /* voxels per axis */
+    int32_t bricks[4];     /* bricks per axis; [3] = brick edge in voxels */
+    uint32_t width, height;
+    uint32_t flags;
+    uint32_t seed;
+    float step;            /* view-ray step, world units */
+    float step_ref;        /* reference step of the transfer function's alpha (one voxel), world */
+    float termination;     /* early ray termination threshold on accumulated opacity */
+    float kd, ks, shininess;
+    uint32_t tf_size, light_tf_size;
+} UmbraFrame;
+
+/* Per-technique shadow parameters, read by the technique's lookup. One struct for all
+ * techniques keeps the raycast kernel's signature fixed; each uses the fields it documents. */
+typedef struct UmbraShadow {
+    float light_to_map[16];   /* light-space maps: world -> map (x, y in texels, z depth) */
+    float map_from_light[16]; /* the inverse */
+    float near_far[4];        /* light-space depth range: near, far, 1/(far-near), unused */
+    float step;               /* reference / map: light-ray step, world units */
+    float threshold;          /* threshold map */
+    float epsilon;            /* deep map */
+    uint32_t map_size;
+    uint32_t taps;
+    uint32_t channels;        /* 1 or 3 light channels */
+    uint32_t block_size;
+    uint32_t tiles_per_row;
+    uint32_t max_nodes;
+    uint32_t seed;
+    uint32_t pad[2];
+} UmbraShadow;
+
+#endif

@@ -1,0 +1,427 @@
+/* tests/reference/cpu_reference.c: see cpu_reference.h. Plain C99 with OpenMP; every formula is
+ * restated here from the documented model rather than shared with the library, so a mistake in
+ * one is not silently repeated in the other. */
+#include "cpu_reference.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct v3 {
+    float x, y, z;
+} v3;
+
+static v3 mk(float x, float y, float z) { v3 r = {x, y, z}; return r; }
+static v3 add(v3 a, v3 b) { return mk(a.x + b.x, a.y + b.y, a.z + b.z); }
+static v3 sub(v3 a, v3 b) { return mk(a.x - b.x, a.y - b.y, a.z - b.z); }
+static v3 mul(v3 a, float s) { return mk(a.x * s, a.y * s, a.z * s); }
+static v3 vmul(v3 a, v3 b) { return mk(a.x * b.x, a.y * b.y, a.z * b.z); }
+static float dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static v3 cross(v3 a, v3 b) { return mk(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
+static v3 norm(v3 a) { float l = sqrtf(dot(a, a)); return l > 0 ? mul(a, 1.0f / l) : a; }
+static v3 from(const float *p) { return mk(p[0], p[1], p[2]); }
+static float lerp(float a, float b, float t) { return a + (b - a) * t; }
+static float clampf(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+/* Everything derived once per render. */
+typedef struct prep {
+    const cpu_scene *s;
+    v3 bmin, bmax, spacing, inv_spacing;
+    float voxel;                  /* world length of one voxel step: the smallest spacing */
+    float *view_tf, *light_tf;    /* alpha corrected for the view step / the shadow step */
+    int view_n, light_n;
+    unsigned char *view_bricks, *light_bricks;
+    int nb[3], B;
+    float step, shadow_step;
+    int colored, point;
+    v3 light_vec;                 /* point position or unit travel direction */
+} prep;
+
+static float sample(const prep *P, v3 p)
+{
+    const cpu_scene *s = P->s;
+    float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+                  (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+                  (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    int i0[3], i1[3];
+    float f[3];
+    for (int a = 0; a < 3; ++a) {
+        x[a] = clampf(x[a], 0.0f, (float)(s->dims[a] - 1));
+        float fl = floorf(x[a]);
+        f[a] = x[a] - fl;
+        i0[a] = (int)fl;
+        i1[a] = i0[a] + 1 < s->dims[a] ? i0[a] + 1 : s->dims[a] - 1;
+    }
+    size_t sy = (size_t)s->dims[0], sz = (size_t)s->dims[0] * s->dims[1];
+#define V(X, Y, Z) s->voxels[(size_t)(Z) * sz + (size_t)(Y) * sy + (size_t)(X)]
+    float c00 = lerp(V(i0[0], i0[1], i0[2]), V(i1[0], i0[1], i0[2]), f[0]);
+    float c10 = lerp(V(i0[0], i1[1], i0[2]), V(i1[0], i1[1], i0[2]), f[0]);
+    float c01 = lerp(V(i0[0], i0[1], i1[2]), V(i1[0], i0[1], i1[2]), f[0]);
+    float c11 = lerp(V(i0[0], i1[1], i1[2]), V(i1[0], i1[1], i1[2]), f[0]);
+#undef V
+    return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
+}
+
+static void lookup(const float *tf, int n, float v, float out[4])
+{
+    float x = clampf(v, 0.0f, 1.0f) * (float)(n - 1);
+    int i = (int)x < n - 2 ? (int)x : n - 2;
+    float f = x - (float)i;
+    for (int c = 0; c < 4; ++c)
+        out[c] = lerp(tf[4 * i + c], tf[4 * i + 4 + c], f);
+}
+
+static float *corrected(const float *tf, int n, float step_voxels)
+{
+    float *t = malloc((size_t)n * 4 * sizeof *t);
+    for (int i = 0; i < n; ++i) {
+        memcpy(t + 4 * i, tf + 4 * i, 3 * sizeof *t);
+        t[4 * i + 3] = 1.0f - powf(1.0f - tf[4 * i + 3], step_voxels);
+    }
+    return t;
+}
+
+/* 1 per brick if any voxel its trilinear footprint reads maps to alpha > 0. */
+static unsigned char *bricks(const prep *P, const float *tf, int n)
+{
+    const cpu_scene *s = P->s;
+    const int B = P->B;
+    unsigned char *out = calloc((size_t)P->nb[0] * P->nb[1] * P->nb[2], 1);
+    for (int bz = 0; bz < P->nb[2]; ++bz)
+        for (int by = 0; by < P->nb[1]; ++by)
+            for (int bx = 0; bx < P->nb[0]; ++bx) {
+                float lo = FLT_MAX, hi = -FLT_MAX;
+                for (int z = bz * B; z <= bz * B + B && z < s->dims[2]; ++z)
+                    for (int y = by * B; y <= by * B + B && y < s->dims[1]; ++y)
+                        for (int x = bx * B; x <= bx * B + B && x < s->dims[0]; ++x) {
+                            float v = s->voxels[((size_t)z * s->dims[1] + y) * s->dims[0] + x];
+                            lo = v < lo ? v : lo;
+                            hi = v > hi ? v : hi;
+                        }
+                int a = (int)floorf(lo * (n - 1)), b = (int)ceilf(hi * (n - 1));
+                a = a < 0 ? 0 : a;
+                b = b > n - 1 ? n - 1 : b;
+                unsigned char vis = 0;
+                for (int i = a; i <= b; ++i)
+                    vis |= tf[4 * i + 3] > 0.0f;
+                out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] = vis;
+            }
+    return out;
+}
+
+static void prep_init(prep *P, const cpu_scene *s)
+{
+    memset(P, 0, sizeof *P);
+    P->s = s;
+    v3 ext = mk(s->dims[0] * s->spacing[0], s->dims[1] * s->spacing[1], s->dims[2] * s->spacing[2]);
+    P->bmin = mul(ext, -0.5f);
+    P->bmax = mul(ext, 0.5f);
+    P->spacing = from(s->spacing);
+    P->inv_spacing = mk(1.0f / s->spacing[0], 1.0f / s->spacing[1], 1.0f / s->spacing[2]);
+    P->voxel = fminf(s->spacing[0], fminf(s->spacing[1], s->spacing[2]));
+    P->step = s->opts.step * P->voxel;
+    P->shadow_step = s->reference_step * P->voxel;
+    P->B = s->brick_size;
+    for (int a = 0; a < 3; ++a)
+        P->nb[a] = (s->dims[a] + P->B - 1) / P->B;
+    const float *ltf = s->light_tf ? s->light_tf : s->tf;
+    P->light_n = s->light_tf ? s->light_tf_count : s->tf_count;
+    P->view_n = s->tf_count;
+    P->view_tf = corrected(s->tf, s->tf_count, s->opts.step);
+    P->light_tf = corrected(ltf, P->light_n, s->reference_step);
+    P->view_bricks = bricks(P, s->tf, s->tf_count);
+    P->light_bricks = bricks(P, ltf, P->light_n);
+    P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
+    P->point = s->light.type == UMBRA_LIGHT_POINT;
+    P->light_vec = P->point ? from(s->light.position) : norm(from(s->light.direction));
+}
+
+static void prep_free(prep *P)
+{
+    free(P->view_tf);
+    free(P->light_tf);
+    free(P->view_bricks);
+    free(P->light_bricks);
+}
+
+static int ray_box(const prep *P, v3 o, v3 d, float *t0, float *t1)
+{
+    float lo = -INFINITY, hi = INFINITY;
+    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, bmax[3] = {P->bmax.x, P->bmax.y, P->bmax.z};
+    for (int a = 0; a < 3; ++a) {
+        if (dd[a] == 0.0f) {
+            if (oo[a] < bmin[a] || oo[a] > bmax[a])
+                return 0;
+            continue;
+        }
+        float ta = (bmin[a] - oo[a]) / dd[a], tb = (bmax[a] - oo[a]) / dd[a];
+        lo = fmaxf(lo, fminf(ta, tb));
+        hi = fminf(hi, fmaxf(ta, tb));
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return 1;
+}
+
+static int brick_of(const prep *P, v3 p, int b[3])
+{
+    float x[3] = {((p.x - P->bmin.x) * P->inv_spacing.x - 0.5f) / P->B,
+                  ((p.y - P->bmin.y) * P->inv_spacing.y - 0.5f) / P->B,
+                  ((p.z - P->bmin.z) * P->inv_spacing.z - 0.5f) / P->B};
+    for (int a = 0; a < 3; ++a) {
+        int i = (int)floorf(x[a]);
+        b[a] = i < 0 ? 0 : (i > P->nb[a] - 1 ? P->nb[a] - 1 : i);
+    }
+    return (b[2] * P->nb[1] + b[1]) * P->nb[0] + b[0];
+}
+
+/* Ray parameter where o + t d leaves the brick holding o + t_now d (border bricks unbounded). */
+static float brick_exit(const prep *P, v3 o, v3 d, float t_now)
+{
+    int b[3];
+    brick_of(P, add(o, mul(d, t_now)), b);
+    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, sp[3] = {P->spacing.x, P->spacing.y, P->spacing.z};
+    float t = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        if (dd[a] > 0.0f && b[a] < P->nb[a] - 1)
+            t = fminf(t, (((float)((b[a] + 1) * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
+        if (dd[a] < 0.0f && b[a] > 0)
+            t = fminf(t, (((float)(b[a] * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
+    }
+    return t;
+}
+
+static int next_after(float t0, float h, float off, float t_exit, int k)
+{
+    float kk = ceilf((t_exit - t0) / h - off);
+    return kk > (float)(k + 1) ? (int)fminf(kk, 2147483000.0f) : k + 1;
+}
+
+/* Unit vector to the light and the distance to it. */
+static v3 to_light(const prep *P, v3 p, float *dist)
+{
+    if (P->point) {
+        v3 v = sub(P->light_vec, p);
+        float l = sqrtf(dot(v, v));
+        *dist = l;
+        return l > 0.0f ? mul(v, 1.0f / l) : mk(0, 1, 0);
+    }
+    *dist = INFINITY;
+    return mul(P->light_vec, -1.0f);
+}
+
+static void pass(const prep *P, const float c[4], float out[3])
+{
+    for (int ch = 0; ch < 3; ++ch)
+        out[ch] = 1.0f - c[3] * (1.0f - (P->colored ? c[ch] : 0.0f));
+}
+
+static v3 shadow(const prep *P, v3 p)
+{
+    float dist;
+    v3 d = to_light(P, p, &dist);
+    float ta, tb;
+    if (!ray_box(P, p, d, &ta, &tb))
+        return mk(1, 1, 1);
+    float t_start = fmaxf(ta, 0.0f), t_end = fminf(tb, dist);
+    if (!(t_end > t_start))
+        return mk(1, 1, 1);
+    const float h = P->shadow_step;
+    float len = t_end - t_start;
+    int n_full = (int)floorf(len / h);
+    float last = len - (float)n_full * h;
+    float T[3] = {1, 1, 1}, c[4], f[3];
+    int skip = P->s->opts.empty_space_skipping, b[3];
+    for (int k = 0; k < n_full;) {
+        float t = t_start + ((float)k + 0.5f) * h;
+        v3 q = add(p, mul(d, t));
+        if (skip && !P->light_bricks[brick_of(P, q, b)]) {
+            k = next_after(t_start, h, 0.5f, brick_exit(P, p, d, t), k);
+            continue;
+        }
+        lookup(P->light_tf, P->light_n, sample(P, q), c);
+        pass(P, c, f);
+        for (int ch = 0; ch < 3; ++ch)
+            T[ch] *= f[ch];
+        if (fmaxf(T[0], fmaxf(T[1], T[2])) < 1e-6f)
+            return mk(0, 0, 0);
+        ++k;
+    }
+    if (last > 0.0f) {
+        v3 q = add(p, mul(d, t_start + (float)n_full * h + 0.5f * last));
+        lookup(P->light_tf, P->light_n, sample(P, q), c);
+        c[3] = 1.0f - powf(1.0f - c[3], last / h);
+        pass(P, c, f);
+        for (int ch = 0; ch < 3; ++ch)
+            T[ch] *= f[ch];
+    }
+    return mk(T[0], T[1], T[2]);
+}
+
+static v3 shadow_factor(const prep *P, v3 p)
+{
+    return P->s->shadow == UMBRA_SHADOW_REFERENCE ? shadow(P, p) : mk(1, 1, 1);
+}
+
+static v3 gradient(const prep *P, v3 p)
+{
+    v3 s = P->spacing;
+    float gx = sample(P, add(p, mk(s.x, 0, 0))) - sample(P, sub(p, mk(s.x, 0, 0)));
+    float gy = sample(P, add(p, mk(0, s.y, 0))) - sample(P, sub(p, mk(0, s.y, 0)));
+    float gz = sample(P, add(p, mk(0, 0, s.z))) - sample(P, sub(p, mk(0, 0, s.z)));
+    return vmul(mul(mk(gx, gy, gz), 0.5f), P->inv_spacing);
+}
+
+static uint32_t hash(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+
+static float random01(uint32_t seed, uint32_t a, uint32_t b, uint32_t c)
+{
+    return (float)(hash(seed ^ hash(a ^ hash(b ^ hash(c)))) >> 8) * (1.0f / 16777216.0f);
+}
+
+typedef struct view {
+    v3 eye, right, up, fwd;
+    int ortho;
+} view;
+
+static view make_view(const cpu_scene *s, uint32_t w, uint32_t h)
+{
+    const umbra_camera *c = &s->camera;
+    view v;
+    v.fwd = norm(sub(from(c->target), from(c->eye)));
+    v3 r = norm(cross(v.fwd, from(c->up)));
+    v3 u = cross(r, v.fwd);
+    float hh = c->projection == UMBRA_ORTHOGRAPHIC ? 0.5f * c->ortho_height
+                                                   : tanf(0.5f * c->fovy_degrees * 3.14159265358979f / 180.0f);
+    float hw = hh * (float)w / (float)h;
+    v.right = mul(r, hw);
+    v.up = mul(u, hh);
+    v.eye = from(c->eye);
+    v.ortho = c->projection == UMBRA_ORTHOGRAPHIC;
+    return v;
+}
+
+static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int px, int py,
+                      float out[4])
+{
+    const cpu_scene *s = P->s;
+    const umbra_render_desc *o = &s->opts;
+    float sx = ((float)px + 0.5f) / (float)w * 2.0f - 1.0f;
+    float sy = 1.0f - ((float)py + 0.5f) / (float)h * 2.0f;
+    v3 org, d;
+    if (V->ortho) {
+        org = add(add(V->eye, mul(V->right, sx)), mul(V->up, sy));
+        d = V->fwd;
+    } else {
+        org = V->eye;
+        d = norm(add(add(V->fwd, mul(V->right, sx)), mul(V->up, sy)));
+    }
+    float ext_y = P->bmax.y - P->bmin.y;
+    float diag = sqrtf(dot(sub(P->bmax, P->bmin), sub(P->bmax, P->bmin)));
+    float y0 = -0.5f * ext_y - o->ground_offset * diag;
+    float t_ground = INFINITY;
+    if (o->ground_plane) {
+        float tg = -(org.y - y0) / d.y;
+        if (d.y < 0.0f && tg > 0.0f)
+            t_ground = tg;
+    }
+    float col[3] = {0, 0, 0}, A = 0.0f, c[4];
+    uint32_t taken = 0;
+    float ta, tb;
+    if (ray_box(P, org, d, &ta, &tb)) {
+        float t0 = fmaxf(ta, 0.0f), t1 = fminf(tb, t_ground);
+        if (t1 > t0) {
+            const float hstep = P->step;
+            float jitter = o->jitter ? random01(o->seed, (uint32_t)px, (uint32_t)py, 0u) : 0.0f;
+            int n = (int)ceilf((t1 - t0) / hstep - jitter), b[3];
+            for (int k = 0; k < n;) {
+                float t = t0 + ((float)k + jitter) * hstep;
+                v3 p = add(org, mul(d, t));
+                if (o->empty_space_skipping && !P->view_bricks[brick_of(P, p, b)]) {
+                    k = next_after(t0, hstep, jitter, brick_exit(P, org, d, t), k);
+                    continue;
+                }
+                ++taken;
+                lookup(P->view_tf, P->view_n, sample(P, p), c);
+                if (c[3] > 0.0f) {
+                    v3 sf = shadow_factor(P, p);
+                    v3 light = vmul(from(s->light.color), sf);
+                    v3 amb = from(o->ambient);
+                    v3 lit;
+                    v3 g = o->shading ? gradient(P, p) : mk(0, 0, 0);
+                    float gl = sqrtf(dot(g, g));
+                    if (!o->shading || !(gl > 1e-6f)) {
+                        lit = vmul(mk(c[0], c[1], c[2]), add(amb, light));
+                    } else {
+                        v3 nrm = mul(g, -1.0f / gl);
+                        float dist;
+                        v3 l = to_light(P, p, &dist);
+                        v3 hv = norm(add(l, mul(d, -1.0f)));
+                        float diff = fabsf(dot(nrm, l));
+                        float spec = powf(fabsf(dot(nrm, hv)), o->shininess);
+                        lit = add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
+                                  mul(light, o->ks * spec));
+                    }
+                    col[0] += (1.0f - A) * c[3] * lit.x;
+                    col[1] += (1.0f - A) * c[3] * lit.y;
+                    col[2] += (1.0f - A) * c[3] * lit.z;
+                    A += (1.0f - A) * c[3];
+                    if (A > o->termination)
+                        break;
+                }
+                ++k;
+            }
+        }
+    }
+    if (t_ground < INFINITY && A <= o->termination) {
+        v3 p = add(org, mul(d, t_ground));
+        v3 sf = shadow_factor(P, p);
+        float dist;
+        float ndl = fmaxf(to_light(P, p, &dist).y, 0.0f);
+        v3 lit = vmul(from(o->ground_color), add(from(o->ambient), mul(vmul(from(s->light.color), sf), ndl)));
+        col[0] += (1.0f - A) * lit.x;
+        col[1] += (1.0f - A) * lit.y;
+        col[2] += (1.0f - A) * lit.z;
+        A = 1.0f;
+    }
+    for (int ch = 0; ch < 3; ++ch)
+        out[ch] = col[ch] + (1.0f - A) * o->background[ch];
+    out[3] = A + (1.0f - A) * o->background[3];
+    return taken;
+}
+
+uint64_t cpu_render(const cpu_scene *s, uint32_t w, uint32_t h, float *rgba)
+{
+    prep P;
+    prep_init(&P, s);
+    view V = make_view(s, w, h);
+    uint64_t total = 0;
+#pragma omp parallel for schedule(dynamic, 4) reduction(+ : total)
+    for (int py = 0; py < (int)h; ++py)
+        for (int px = 0; px < (int)w; ++px)
+            total += pixel(&P, &V, w, h, px, py, rgba + 4 * ((size_t)py * w + px));
+    prep_free(&P);
+    return total;
+}
+
+void cpu_shadow(const cpu_scene *s, const float p[3], float rgb[3])
+{
+    prep P;
+    prep_init(&P, s);
+    v3 r = shadow(&P, from(p));
+    rgb[0] = r.x;
+    rgb[1] = r.y;
+    rgb[2] = r.z;
+    prep_free(&P);
+}

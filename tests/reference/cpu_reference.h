@@ -1,0 +1,35 @@
+/* tests/reference/cpu_reference.h: a plain-C implementation of umbra's ray caster and exact
+ * shadow reference, written from the algorithm's description (renderer.h's shading model and
+ * kernels/raycast.cl's steps) without sharing code with the library. The tests check the OpenCL
+ * kernels against it; umbra-bench times it (OpenMP, -O3) as the native-C baseline. */
+#ifndef UMBRA_CPU_REFERENCE_H
+#define UMBRA_CPU_REFERENCE_H
+
+#include <stdint.h>
+
+#include "umbra/renderer.h"
+
+typedef struct cpu_scene {
+    const float *voxels;          /* normalised values in [0,1], x fastest */
+    int dims[3];
+    float spacing[3];
+    const float *tf;              /* RGBA table as given to umbra (alpha per voxel) */
+    int tf_count;
+    const float *light_tf;        /* NULL: tf */
+    int light_tf_count;
+    umbra_camera camera;
+    umbra_light light;
+    umbra_render_desc opts;
+    umbra_shadow_technique shadow;/* UMBRA_SHADOW_NONE or UMBRA_SHADOW_REFERENCE */
+    float reference_step;         /* voxels */
+    int brick_size;               /* empty-space skipping bricks (as the volume's) */
+} cpu_scene;
+
+/* Renders w x h premultiplied RGBA floats; returns the number of samples taken (samples skipped
+ * in empty bricks are not counted, as on the device). Parallel over rows with OpenMP. */
+uint64_t cpu_render(const cpu_scene *s, uint32_t w, uint32_t h, float *rgba);
+
+/* The shadow factor at world point p (the exact reference's transmittance). */
+void cpu_shadow(const cpu_scene *s, const float p[3], float rgb[3]);
+
+#endif

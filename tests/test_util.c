@@ -1,0 +1,87 @@
+/* tests/test_util.c: see test_util.h. */
+#define _POSIX_C_SOURCE 200809L
+#include "test_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+umbra_context test_context(void)
+{
+    umbra_context_desc d;
+    umbra_context_desc_init(&d);
+    if (!getenv("UMBRA_DEVICE"))
+        d.device_name = "pthread"; /* PoCL's CPU device: the tests' target */
+    umbra_context ctx = NULL;
+    if (umbra_context_create(&d, &ctx) != UMBRA_SUCCESS) {
+        umbra_context_desc_init(&d);
+        if (umbra_context_create(&d, &ctx) != UMBRA_SUCCESS)
+            fail_msg("test_context: no OpenCL device (is pocl-opencl-icd installed?)");
+    }
+    return ctx;
+}
+
+static char tmpdir[256];
+
+static void remove_tmpdir(void)
+{
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "test_util: could not remove %s\n", tmpdir);
+}
+
+const char *test_tmpdir(void)
+{
+    if (!tmpdir[0]) {
+        const char *base = getenv("TMPDIR");
+        snprintf(tmpdir, sizeof tmpdir, "%s/umbra-test-XXXXXX", base && *base ? base : "/tmp");
+        if (!mkdtemp(tmpdir))
+            fail_msg("test_tmpdir: mkdtemp(%s) failed", tmpdir);
+        atexit(remove_tmpdir);
+    }
+    return tmpdir;
+}
+
+int test_message_contains(umbra_context ctx, const char *needle)
+{
+    const char *m = umbra_context_last_message(ctx);
+    if (!strstr(m, needle)) {
+        print_message("message '%s' lacks '%s'\n", m, needle);
+        return 0;
+    }
+    return 1;
+}
+
+umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                  float value)
+{
+    size_t n = (size_t)nx * ny * nz;
+    float *data = malloc(n * sizeof *data);
+    assert_non_null(data);
+    for (size_t i = 0; i < n; ++i)
+        data[i] = value;
+    umbra_volume_desc d;
+    umbra_volume_desc_init(&d);
+    d.data = data;
+    d.type = UMBRA_FLOAT32;
+    d.dims[0] = nx;
+    d.dims[1] = ny;
+    d.dims[2] = nz;
+    d.value_range_given = 1;
+    d.value_min = 0.0f;
+    d.value_max = 1.0f;
+    umbra_volume v = NULL;
+    umbra_status st = umbra_volume_create(ctx, &d, &v);
+    free(data);
+    assert_int_equal(st, UMBRA_SUCCESS);
+    return v;
+}
+
+umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha)
+{
+    float rgba[8] = {grey, grey, grey, alpha, grey, grey, grey, alpha};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
+    return tf;
+}

@@ -1,0 +1,32 @@
+/* tests/test_util.h: helpers every umbra test shares: a context on the CPU (PoCL), a scratch
+ * directory, and message checks. */
+#ifndef UMBRA_TEST_UTIL_H
+#define UMBRA_TEST_UTIL_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "umbra/umbra.h"
+
+/* A context on PoCL's CPU device (or $UMBRA_DEVICE); fails the test if none can be made. The
+ * PoCL cache goes to the build tree when ctest sets POCL_CACHE_DIR. */
+umbra_context test_context(void);
+
+/* A fresh mkdtemp directory for this process, removed at exit. */
+const char *test_tmpdir(void);
+
+/* Nonzero if the context's last error message contains needle. */
+int test_message_contains(umbra_context ctx, const char *needle);
+
+/* A float32 volume of dims filled with value, value range [0, 1]. */
+umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                  float value);
+
+/* A grey transfer function with constant alpha (per voxel) everywhere. */
+umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha);
+
+#endif
