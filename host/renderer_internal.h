@@ -11,7 +11,7 @@
 #include "umbra_shared.h"
 
 _Static_assert(sizeof(UmbraFrame) == 13 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
-_Static_assert(sizeof(UmbraShadow) == 32 * 4 + 4 * 4 + 3 * 4 + 7 * 4 + 2 * 4, "UmbraShadow layout");
+_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 3 * 4 + 8 * 4 + 13 * 4, "UmbraShadow layout");
 
 typedef struct umbra__technique {
     umbra_shadow_technique id;

@@ -52,23 +52,32 @@ typedef struct UmbraFrame {
     uint32_t tf_size, light_tf_size;
 } UmbraFrame;
 
-/* Per-technique shadow parameters, read by the technique's lookup. One struct for all
- * techniques keeps the raycast kernel's signature fixed; each uses the fields it documents. */
+/* Light-space map projections (UmbraShadow.ls_mode). */
+#define UMBRA_LS_ORTHO 0u       /* directional light: parallel rays, map on a plane */
+#define UMBRA_LS_PERSPECTIVE 1u /* point light outside the box: a frustum around it */
+#define UMBRA_LS_OCTAHEDRAL 2u  /* point light at, inside or very near the box: every direction */
+
+/* Per-technique shadow parameters. One struct for all techniques keeps the ray caster's
+ * signature fixed; each technique uses the fields it documents. The ls_* fields describe the
+ * light-space map (host/lightspace.c fills them, kernels/lightspace.cl reads them). */
 typedef struct UmbraShadow {
-    float light_to_map[16];   /* light-space maps: world -> map (x, y in texels, z depth) */
-    float map_from_light[16]; /* the inverse */
-    float near_far[4];        /* light-space depth range: near, far, 1/(far-near), unused */
-    float step;               /* reference / map: light-ray step, world units */
+    float ls_u[4], ls_v[4], ls_w[4]; /* light basis: u, v across the map, w along the light */
+    float ls_origin[4];       /* point light position */
+    float ls_window[4];       /* u_min, v_min, 1/(u_max-u_min), 1/(v_max-v_min): plane units
+                                 (ortho) or tangents (perspective) */
+    float near_far[4];        /* depth range along the light: near, far, 1/(far-near), unused */
+    float step;               /* reference / maps: light-ray step, world units */
     float threshold;          /* threshold map */
     float epsilon;            /* deep map */
-    uint32_t map_size;
-    uint32_t taps;
+    uint32_t map_size;        /* texels per side */
+    uint32_t taps;            /* CSSM / filtered threshold: taps per lookup */
     uint32_t channels;        /* 1 or 3 light channels */
-    uint32_t block_size;
-    uint32_t tiles_per_row;
-    uint32_t max_nodes;
-    uint32_t seed;
-    uint32_t pad[2];
+    uint32_t block_size;      /* deep map: node layers per block */
+    uint32_t tiles_per_row;   /* deep map: tiles per map row */
+    uint32_t max_nodes;       /* deep map: node budget per channel (0 = unbounded) */
+    uint32_t seed;            /* CSSM */
+    uint32_t ls_mode;         /* UMBRA_LS_* */
+    uint32_t pad[13];         /* room for technique fields without changing the size */
 } UmbraShadow;
 
 #endif

@@ -1,0 +1,129 @@
+/* host/lightspace.c: fitting a light-space map to the volume's box. See lightspace.h. */
+#include <math.h>
+#include <string.h>
+
+#include "lightspace.h"
+
+static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void basis_from(const float w_in[3], float u[3], float v[3], float w[3])
+{
+    float l = sqrtf(dot3(w_in, w_in));
+    for (int i = 0; i < 3; ++i)
+        w[i] = w_in[i] / l;
+    /* Any vector not parallel to w gives a basis; pick the axis w is least aligned with. */
+    float a[3] = {0, 0, 0};
+    int k = fabsf(w[0]) < fabsf(w[1]) ? (fabsf(w[0]) < fabsf(w[2]) ? 0 : 2) : (fabsf(w[1]) < fabsf(w[2]) ? 1 : 2);
+    a[k] = 1.0f;
+    u[0] = a[1] * w[2] - a[2] * w[1];
+    u[1] = a[2] * w[0] - a[0] * w[2];
+    u[2] = a[0] * w[1] - a[1] * w[0];
+    l = sqrtf(dot3(u, u));
+    for (int i = 0; i < 3; ++i)
+        u[i] /= l;
+    v[0] = w[1] * u[2] - w[2] * u[1];
+    v[1] = w[2] * u[0] - w[0] * u[2];
+    v[2] = w[0] * u[1] - w[1] * u[0];
+}
+
+static void set4(float d[4], const float s[3], float w)
+{
+    d[0] = s[0];
+    d[1] = s[1];
+    d[2] = s[2];
+    d[3] = w;
+}
+
+void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
+{
+    UmbraShadow *S = &r->shadow_params;
+    const UmbraFrame *F = &r->frame;
+    float corners[8][3];
+    for (int c = 0; c < 8; ++c)
+        for (int a = 0; a < 3; ++a)
+            corners[c][a] = (c >> a) & 1 ? F->box_max[a] : F->box_min[a];
+    float u[3], v[3], w[3];
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    S->map_size = map_size;
+    memset(S->ls_origin, 0, sizeof S->ls_origin);
+
+    if (r->light.type == UMBRA_LIGHT_DIRECTIONAL) {
+        basis_from(r->light.direction, u, v, w);
+        for (int c = 0; c < 8; ++c) {
+            float p[3] = {dot3(corners[c], u), dot3(corners[c], v), dot3(corners[c], w)};
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = fminf(lo[a], p[a]);
+                hi[a] = fmaxf(hi[a], p[a]);
+            }
+        }
+        S->ls_mode = UMBRA_LS_ORTHO;
+    } else {
+        const float *P = r->light.position;
+        float centre[3] = {-P[0], -P[1], -P[2]}; /* the box is centred on the origin */
+        float dist_centre = sqrtf(dot3(centre, centre));
+        /* Nearest box point: distance 0 inside; farthest: the farthest corner. */
+        float near2 = 0.0f;
+        for (int a = 0; a < 3; ++a) {
+            float d = P[a] < F->box_min[a] ? F->box_min[a] - P[a] : (P[a] > F->box_max[a] ? P[a] - F->box_max[a] : 0.0f);
+            near2 += d * d;
+        }
+        lo[2] = sqrtf(near2);
+        hi[2] = 0.0f;
+        for (int c = 0; c < 8; ++c) {
+            float q[3] = {corners[c][0] - P[0], corners[c][1] - P[1], corners[c][2] - P[2]};
+            hi[2] = fmaxf(hi[2], sqrtf(dot3(q, q)));
+        }
+        S->ls_mode = UMBRA_LS_OCTAHEDRAL;
+        set4(S->ls_origin, P, 0.0f);
+        if (dist_centre > 0.0f) {
+            basis_from(centre, u, v, w);
+            float tmax = 0.0f;
+            int in_front = 1;
+            for (int c = 0; c < 8; ++c) {
+                float q[3] = {corners[c][0] - P[0], corners[c][1] - P[1], corners[c][2] - P[2]};
+                float z = dot3(q, w);
+                if (!(z > 0.0f)) {
+                    in_front = 0;
+                    break;
+                }
+                float x = dot3(q, u) / z, y = dot3(q, v) / z;
+                lo[0] = fminf(lo[0], x);
+                hi[0] = fmaxf(hi[0], x);
+                lo[1] = fminf(lo[1], y);
+                hi[1] = fmaxf(hi[1], y);
+                tmax = fmaxf(tmax, fmaxf(fabsf(x), fabsf(y)));
+            }
+            /* tan(70 deg) = 2.75: beyond that a frustum wastes most texels at its rim. */
+            if (in_front && tmax < 2.75f)
+                S->ls_mode = UMBRA_LS_PERSPECTIVE;
+        } else {
+            const float up[3] = {0.0f, 1.0f, 0.0f};
+            basis_from(up, u, v, w);
+        }
+        if (S->ls_mode == UMBRA_LS_OCTAHEDRAL) {
+            lo[0] = lo[1] = -1.0f;
+            hi[0] = hi[1] = 1.0f;
+        }
+    }
+    /* Half a texel of margin so that bilinear taps at the rim still see the box. */
+    for (int a = 0; a < 2; ++a) {
+        float pad = S->ls_mode == UMBRA_LS_OCTAHEDRAL ? 0.0f : (hi[a] - lo[a]) / (float)map_size;
+        lo[a] -= pad;
+        hi[a] += pad;
+        if (!(hi[a] > lo[a]))
+            hi[a] = lo[a] + 1e-6f;
+    }
+    if (!(hi[2] > lo[2]))
+        hi[2] = lo[2] + 1e-6f;
+    set4(S->ls_u, u, 0.0f);
+    set4(S->ls_v, v, 0.0f);
+    set4(S->ls_w, w, 0.0f);
+    S->ls_window[0] = lo[0];
+    S->ls_window[1] = lo[1];
+    S->ls_window[2] = 1.0f / (hi[0] - lo[0]);
+    S->ls_window[3] = 1.0f / (hi[1] - lo[1]);
+    S->near_far[0] = lo[2];
+    S->near_far[1] = hi[2];
+    S->near_far[2] = 1.0f / (hi[2] - lo[2]);
+    S->near_far[3] = 0.0f;
+}
