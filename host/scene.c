@@ -17,10 +17,10 @@ typedef struct sphere {
 } sphere;
 
 static const sphere spheres[] = {
-    {{0.30f, 0.62f, 0.38f}, 0.20f, 1.00f}, /* near-opaque white */
-    {{0.68f, 0.72f, 0.62f}, 0.18f, 0.30f}, /* translucent red */
-    {{0.52f, 0.30f, 0.70f}, 0.17f, 0.55f}, /* translucent green */
-    {{0.72f, 0.28f, 0.26f}, 0.15f, 0.80f}, /* translucent blue */
+    {{0.34f, 0.76f, 0.42f}, 0.17f, 1.00f}, /* near-opaque white, high: shadows the red one */
+    {{0.58f, 0.44f, 0.50f}, 0.18f, 0.30f}, /* translucent red */
+    {{0.28f, 0.24f, 0.66f}, 0.16f, 0.55f}, /* translucent green */
+    {{0.74f, 0.20f, 0.26f}, 0.15f, 0.80f}, /* translucent blue */
 };
 
 static float smooth_edge(float d, float width)
@@ -86,9 +86,9 @@ static void default_light(umbra_light *l)
 {
     memset(l, 0, sizeof *l);
     l->type = UMBRA_LIGHT_DIRECTIONAL;
-    l->direction[0] = 0.45f;
+    l->direction[0] = 0.5f;
     l->direction[1] = -1.0f;
-    l->direction[2] = 0.25f;
+    l->direction[2] = 0.2f;
     l->color[0] = l->color[1] = l->color[2] = 1.0f;
 }
 
@@ -108,6 +108,7 @@ umbra_status umbra_scene_create(umbra_context ctx, const char *name, uint32_t re
     umbra_status st = UMBRA_SUCCESS;
     float *data = NULL;
     umbra_render_desc_init(&out->options);
+    out->options.ground_color[0] = out->options.ground_color[1] = out->options.ground_color[2] = 0.55f;
     default_light(&out->light);
     float diag = 0.0f;
     if (strcmp(name, "spheres") == 0) {
@@ -134,7 +135,7 @@ umbra_status umbra_scene_create(umbra_context ctx, const char *name, uint32_t re
             goto fail;
         out->options.ground_plane = 1;
         out->options.transmission = UMBRA_TRANSMISSION_COLORED;
-        diag = sqrtf(3.0f) * (float)n;
+        diag = 0.75f * sqrtf(3.0f) * (float)n; /* frame the spheres, not the whole box */
     } else if (strcmp(name, "slab") == 0) {
         uint32_t n = res ? res : 64, h = n / 4 ? n / 4 : 1;
         data = malloc((size_t)n * h * n * sizeof *data);
@@ -178,7 +179,7 @@ umbra_status umbra_scene_create(umbra_context ctx, const char *name, uint32_t re
     }
     free(data);
     const float dir[3] = {0.75f, 0.5f, 1.0f};
-    out->camera = umbra_camera_orbit(dir, diag * 1.15f, 30.0f);
+    out->camera = umbra_camera_orbit(dir, diag, 30.0f);
     out->camera.target[1] = -0.08f * diag; /* look a little down, to show the plane */
     return UMBRA_SUCCESS;
 oom:
