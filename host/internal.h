@@ -66,7 +66,7 @@ struct umbra_context_t {
     int is_cpu;
     int has_float_r_image3d;
     umbra_sampler_kind sampler;
-    char device_name[512];
+    char device_name[600];              /* "platform / device": two 256-byte names */
     umbra__program *programs;           /* cache: one entry per (sources, options) */
     umbra_status first_error;           /* sticky until umbra_context_take_error */
     char first_message[UMBRA_MESSAGE_MAX];
@@ -132,7 +132,8 @@ uint64_t umbra__next_id(umbra_context ctx);
 
 /* ---- helpers shared by the I/O modules -------------------------------------------------------- */
 
-/* Reads a whole file into a malloc'ed buffer. */
+/* Reads a whole file into a malloc'ed buffer, followed by one NUL byte not counted in *size (the
+ * text parsers rely on it). */
 umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *path, void **data,
                               size_t *size);
 

@@ -36,8 +36,9 @@ umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
                                                         uint32_t count, uint32_t resolution,
                                                         umbra_transfer_function *out);
 
-/* Reads the text format documented in the README: '#' comments, an optional line
- * "resolution N" (default 256), then one control point "value r g b a" per line. */
+/* Reads the text format documented in the README (and host/tf_file.c): '#' comments, an optional
+ * line "resolution N" (default 256) before the first point, then one control point
+ * "value r g b a" per line, values ascending (equal values make a step). */
 umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                           umbra_transfer_function *out);
 

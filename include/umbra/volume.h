@@ -48,12 +48,14 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .dat (Voreen). */
 umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem. Spacing comes from
- * the header's spacings or space directions (1 where absent). */
+/* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
+ * short and float; 3-D, or 4-D with a size-1 first axis. Spacing comes from the header's spacings
+ * or space directions (1 where absent). */
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads a Voreen .dat header (ObjectFileName, Resolution, SliceThickness, Format) and its raw
- * file, which is looked up relative to the .dat's directory. */
+/* Loads a Voreen .dat header and its raw file, which is looked up relative to the .dat's
+ * directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
+ * are required; ObjectModel, if present, must be I. */
 umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
 
 typedef struct umbra_raw_desc {

@@ -1,0 +1,718 @@
+/* host/io_volume.c: reading volumes from files.
+ *
+ * Three readers, all ending in umbra_volume_create: NRRD through Teem (attached .nrrd or detached
+ * .nhdr), Voreen's .dat text header over a raw file, and plain headerless raw files described by
+ * an umbra_raw_desc. Also the whole-file reader the other I/O modules share.
+ *
+ * Teem keeps its errors in a process-wide store (biff) and reads the global nrrdStateVerboseIO to
+ * decide whether to print. Both are wrong for a library inside another program, so every Teem call
+ * runs under one lock, with verbosity off, and its error text is moved straight into the context's
+ * message and freed. Text is parsed in the "C" numeric locale whatever the application has set. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <limits.h>
+#include <locale.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include <teem/nrrd.h>
+
+#include "internal.h"
+
+/* Messages quote at most this much of a value taken from a file. */
+#define QUOTE_MAX 200
+
+/* ---- files -------------------------------------------------------------------------------- */
+
+static const char *errno_text(int err, char *buf, size_t n)
+{
+    /* strerror_r (XSI form under _POSIX_C_SOURCE) rather than strerror, which may share a
+     * static buffer between threads. */
+    if (strerror_r(err, buf, n) != 0) {
+        snprintf(buf, n, "error %d", err);
+    }
+    return buf;
+}
+
+/* Opens a regular file for reading and returns its size. Refusing directories and devices here
+ * gives a clear message instead of a puzzling failure in fread. */
+static umbra_status file_open(umbra_context ctx, const char *func, const char *path, FILE **out,
+                              size_t *size)
+{
+    char buf[256];
+    struct stat sb;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\": %s", func, path,
+                           errno_text(errno, buf, sizeof buf));
+    }
+    if (fstat(fileno(f), &sb) != 0) {
+        int err = errno;
+        fclose(f);
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot stat \"%s\": %s", func, path,
+                           errno_text(err, buf, sizeof buf));
+    }
+    if (!S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: \"%s\" is not a regular file", func, path);
+    }
+    if (sb.st_size < 0 || (uintmax_t)sb.st_size >= SIZE_MAX) {
+        fclose(f);
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: \"%s\" is too large to read (%jd bytes)",
+                           func, path, (intmax_t)sb.st_size);
+    }
+    *out = f;
+    *size = (size_t)sb.st_size;
+    return UMBRA_SUCCESS;
+}
+
+/* Reads exactly size bytes from f, which is path, into dst. */
+static umbra_status file_read(umbra_context ctx, const char *func, const char *path, FILE *f,
+                              void *dst, size_t size)
+{
+    char buf[256];
+    size_t got = fread(dst, 1, size, f);
+    if (got != size) {
+        if (ferror(f)) {
+            return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot read \"%s\": %s", func, path,
+                               errno_text(errno, buf, sizeof buf));
+        }
+        return umbra__fail(ctx, UMBRA_ERROR_IO,
+                           "%s: \"%s\" ended after %zu of %zu bytes (changed while reading?)",
+                           func, path, got, size);
+    }
+    return UMBRA_SUCCESS;
+}
+
+/* The buffer holds one byte more than the file, a NUL, so that text readers can treat it as a
+ * string; *size does not count it. */
+umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *path, void **data,
+                              size_t *size)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    FILE *f = NULL;
+    char *buf = NULL;
+    size_t n = 0;
+
+    if (!data || !size) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: data or size is NULL", func);
+    }
+    *data = NULL;
+    *size = 0;
+    if (!path) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", func);
+    }
+    st = file_open(ctx, func, path, &f, &n);
+    if (st != UMBRA_SUCCESS) {
+        goto fail;
+    }
+    buf = malloc(n + 1);
+    if (!buf) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes for \"%s\"",
+                         func, n + 1, path);
+        goto fail;
+    }
+    st = file_read(ctx, func, path, f, buf, n);
+    if (st != UMBRA_SUCCESS) {
+        goto fail;
+    }
+    buf[n] = '\0';
+    fclose(f);
+    *data = buf;
+    *size = n;
+    return UMBRA_SUCCESS;
+
+fail:
+    free(buf);
+    if (f) {
+        fclose(f);
+    }
+    return st;
+}
+
+/* ---- small helpers ------------------------------------------------------------------------ */
+
+static int ascii_lower(int c)
+{
+    return (c >= 'A' && c <= 'Z') ? c - 'A' + 'a' : c;
+}
+
+/* Case-insensitive ASCII comparison of a counted string with a C string. */
+static int equal_nocase(const char *s, size_t n, const char *lit)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        if (lit[i] == '\0' ||
+            ascii_lower((unsigned char)s[i]) != ascii_lower((unsigned char)lit[i])) {
+            return 0;
+        }
+    }
+    return lit[n] == '\0';
+}
+
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* The extension of path (after the last '.' of the last component), or "" if none. */
+static const char *path_extension(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    return (dot && dot != base) ? dot + 1 : "";
+}
+
+static int host_is_big_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char first;
+    memcpy(&first, &one, 1);
+    return first == 0;
+}
+
+static void swap_bytes(void *data, size_t count, size_t width)
+{
+    unsigned char *p = data;
+    size_t i, j;
+    for (i = 0; i < count; ++i, p += width) {
+        for (j = 0; j < width / 2; ++j) {
+            unsigned char t = p[j];
+            p[j] = p[width - 1 - j];
+            p[width - 1 - j] = t;
+        }
+    }
+}
+
+/* Switches this thread to the "C" numeric locale, so "0.5" parses the same whatever locale the
+ * application chose; returns what to hand to locale_restore. */
+typedef struct locale_switch {
+    locale_t c_locale;
+    locale_t previous;
+} locale_switch;
+
+static locale_switch locale_use_c(void)
+{
+    locale_switch s = {(locale_t)0, (locale_t)0};
+    s.c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+    if (s.c_locale != (locale_t)0) {
+        s.previous = uselocale(s.c_locale);
+    }
+    return s;
+}
+
+static void locale_restore(locale_switch s)
+{
+    if (s.c_locale != (locale_t)0) {
+        uselocale(s.previous);
+        freelocale(s.c_locale);
+    }
+}
+
+/* ---- raw ---------------------------------------------------------------------------------- */
+
+void umbra_raw_desc_init(umbra_raw_desc *desc)
+{
+    if (!desc) {
+        return;
+    }
+    memset(desc, 0, sizeof *desc);
+    desc->struct_size = sizeof *desc;
+    desc->type = UMBRA_UINT8;
+    desc->spacing[0] = desc->spacing[1] = desc->spacing[2] = 1.0f;
+    desc->big_endian = 0;
+    desc->header_bytes = 0;
+}
+
+/* Hands voxels already in host memory to umbra_volume_create. */
+static umbra_status create_volume(umbra_context ctx, const void *data, umbra_scalar_type type,
+                                  const uint32_t dims[3], const float spacing[3],
+                                  umbra_volume *out)
+{
+    umbra_volume_desc vd;
+    umbra_volume_desc_init(&vd);
+    vd.data = data;
+    vd.type = type;
+    memcpy(vd.dims, dims, sizeof vd.dims);
+    memcpy(vd.spacing, spacing, sizeof vd.spacing);
+    return umbra_volume_create(ctx, &vd, out);
+}
+
+/* The raw reader behind umbra_volume_load_raw and umbra_volume_load_dat; func names the public
+ * function in messages. */
+static umbra_status load_raw(umbra_context ctx, const char *func, const char *path,
+                             const umbra_raw_desc *desc, umbra_volume *out)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    FILE *f = NULL;
+    void *voxels = NULL;
+    size_t file_size = 0, type_size, count, data_bytes, expected;
+    int i;
+
+    type_size = umbra_scalar_type_size(desc->type);
+    if (type_size == 0) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: scalar type %d is unknown (expected UMBRA_UINT8, UMBRA_UINT16, "
+                           "UMBRA_INT16 or UMBRA_FLOAT32)",
+                           func, (int)desc->type);
+    }
+    count = 1;
+    for (i = 0; i < 3; ++i) {
+        if (desc->dims[i] == 0) {
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: dims %u x %u x %u: every size must be > 0", func,
+                               desc->dims[0], desc->dims[1], desc->dims[2]);
+        }
+        if (count > SIZE_MAX / desc->dims[i]) {
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: dims %u x %u x %u: too many voxels", func, desc->dims[0],
+                               desc->dims[1], desc->dims[2]);
+        }
+        count *= desc->dims[i];
+        if (!(desc->spacing[i] > 0.0f) || !isfinite(desc->spacing[i])) {
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: spacing %g x %g x %g: each must be finite and > 0", func,
+                               (double)desc->spacing[0], (double)desc->spacing[1],
+                               (double)desc->spacing[2]);
+        }
+    }
+    if (count > SIZE_MAX / type_size || count * type_size > SIZE_MAX - desc->header_bytes) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: dims %u x %u x %u plus %zu header bytes: too large", func,
+                           desc->dims[0], desc->dims[1], desc->dims[2], desc->header_bytes);
+    }
+    data_bytes = count * type_size;
+    expected = desc->header_bytes + data_bytes;
+
+    /* Check the size before reading, so a wrong header costs nothing on a large file. */
+    st = file_open(ctx, func, path, &f, &file_size);
+    if (st != UMBRA_SUCCESS) {
+        goto fail;
+    }
+    if (file_size != expected) {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\" holds %zu bytes, expected %zu (%zu header bytes + "
+                         "%u x %u x %u voxels of %zu bytes)",
+                         func, path, file_size, expected, desc->header_bytes, desc->dims[0],
+                         desc->dims[1], desc->dims[2], type_size);
+        goto fail;
+    }
+    if (desc->header_bytes > 0 && fseeko(f, (off_t)desc->header_bytes, SEEK_SET) != 0) {
+        char buf[256];
+        st = umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot skip %zu header bytes of \"%s\": %s",
+                         func, desc->header_bytes, path, errno_text(errno, buf, sizeof buf));
+        goto fail;
+    }
+    voxels = malloc(data_bytes);
+    if (!voxels) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                         "%s: cannot allocate %zu bytes for the voxels of \"%s\"", func,
+                         data_bytes, path);
+        goto fail;
+    }
+    st = file_read(ctx, func, path, f, voxels, data_bytes);
+    if (st != UMBRA_SUCCESS) {
+        goto fail;
+    }
+    fclose(f);
+    f = NULL;
+    if (type_size > 1 && (desc->big_endian != 0) != host_is_big_endian()) {
+        swap_bytes(voxels, count, type_size);
+    }
+    st = create_volume(ctx, voxels, desc->type, desc->dims, desc->spacing, out);
+
+fail:
+    free(voxels);
+    if (f) {
+        fclose(f);
+    }
+    return st;
+}
+
+umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
+                                   umbra_volume *out)
+{
+    if (!out) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+    }
+    *out = NULL;
+    if (!ctx) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
+    }
+    if (!path) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
+    }
+    if (!desc) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", __func__);
+    }
+    if (desc->struct_size != sizeof(umbra_raw_desc)) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->struct_size is %zu, expected %zu (call umbra_raw_desc_init)",
+                           __func__, desc->struct_size, sizeof(umbra_raw_desc));
+    }
+    return load_raw(ctx, __func__, path, desc, out);
+}
+
+/* ---- NRRD --------------------------------------------------------------------------------- */
+
+/* Serialises umbra's use of Teem's process-wide state (biff, nrrdStateVerboseIO). It is the one
+ * mutable global here, and it exists to contain someone else's. */
+static pthread_mutex_t teem_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* Turns biff's "[nrrd] a\n[nrrd] b\n" into "a; b" in place. */
+static void flatten_biff(char *msg)
+{
+    char *src = msg, *dst = msg;
+    while (*src) {
+        if (strncmp(src, "[nrrd] ", 7) == 0) {
+            src += 7;
+        }
+        while (*src && *src != '\n') {
+            *dst++ = *src++;
+        }
+        while (*src == '\n') {
+            ++src;
+        }
+        if (*src) {
+            *dst++ = ';';
+            *dst++ = ' ';
+        }
+    }
+    *dst = '\0';
+}
+
+/* World units between samples along one axis: the axis spacing, else the length of its space
+ * direction, else 1. */
+static float nrrd_axis_spacing(const Nrrd *nrrd, unsigned int axis)
+{
+    double s = nrrd->axis[axis].spacing;
+    if (isfinite(s) && s != 0.0) {
+        return (float)fabs(s);
+    }
+    if (nrrd->spaceDim > 0) {
+        s = nrrdSpaceVecNorm(nrrd->spaceDim, nrrd->axis[axis].spaceDirection);
+        if (isfinite(s) && s > 0.0) {
+            return (float)s;
+        }
+    }
+    return 1.0f;
+}
+
+/* A 4-D array whose first axis has size 1 (a one-component "vector" volume, as some tools
+ * write) is accepted as the 3-D volume it is. */
+umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    Nrrd *nrrd = NULL;
+    char *biff_msg = NULL;
+    umbra_scalar_type type = UMBRA_UINT8;
+    uint32_t dims[3];
+    float spacing[3];
+    unsigned int first_axis = 0, i;
+    int load_failed, verbose;
+    locale_switch loc;
+    FILE *probe;
+
+    if (!out) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+    }
+    *out = NULL;
+    if (!ctx) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
+    }
+    if (!path) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
+    }
+    /* A file that cannot be opened is an I/O error; Teem would report it as a parse failure. */
+    probe = fopen(path, "rb");
+    if (!probe) {
+        char buf[256];
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\": %s", __func__, path,
+                           errno_text(errno, buf, sizeof buf));
+    }
+    fclose(probe);
+
+    nrrd = nrrdNew();
+    if (!nrrd) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: nrrdNew failed for \"%s\"",
+                         __func__, path);
+        goto fail;
+    }
+    pthread_mutex_lock(&teem_lock);
+    verbose = nrrdStateVerboseIO;
+    nrrdStateVerboseIO = 0;
+    loc = locale_use_c();
+    load_failed = nrrdLoad(nrrd, path, NULL);
+    locale_restore(loc);
+    nrrdStateVerboseIO = verbose;
+    if (load_failed) {
+        biff_msg = biffGetDone(NRRD);
+    }
+    pthread_mutex_unlock(&teem_lock);
+    if (load_failed) {
+        if (biff_msg) {
+            flatten_biff(biff_msg);
+        }
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: cannot read \"%s\": %s", __func__, path,
+                         biff_msg ? biff_msg : "Teem gave no reason");
+        goto fail;
+    }
+
+    switch (nrrd->type) {
+    case nrrdTypeUChar: type = UMBRA_UINT8; break;
+    case nrrdTypeUShort: type = UMBRA_UINT16; break;
+    case nrrdTypeShort: type = UMBRA_INT16; break;
+    case nrrdTypeFloat: type = UMBRA_FLOAT32; break;
+    default:
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\" has type %s; supported are uchar, ushort, short and float",
+                         __func__, path, airEnumStr(nrrdType, nrrd->type));
+        goto fail;
+    }
+    if (nrrd->dim == 4 && nrrd->axis[0].size == 1) {
+        first_axis = 1;
+    } else if (nrrd->dim != 3) {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\" has dimension %u; a volume must have 3 (or 4 with a first "
+                         "axis of size 1)",
+                         __func__, path, nrrd->dim);
+        goto fail;
+    }
+    for (i = 0; i < 3; ++i) {
+        size_t size = nrrd->axis[first_axis + i].size;
+        if (size == 0 || size > UINT32_MAX) {
+            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": axis %u has size %zu",
+                             __func__, path, first_axis + i, size);
+            goto fail;
+        }
+        dims[i] = (uint32_t)size;
+        spacing[i] = nrrd_axis_spacing(nrrd, first_axis + i);
+    }
+    st = create_volume(ctx, nrrd->data, type, dims, spacing, out);
+
+fail:
+    free(biff_msg);
+    if (nrrd) {
+        nrrdNuke(nrrd);
+    }
+    return st;
+}
+
+/* ---- Voreen .dat ------------------------------------------------------------------------ */
+
+/* Parses exactly n numbers separated by blanks from s (NUL-terminated). Integers when ints is
+ * set (into u), else floats (into f). Returns 0 on any stray text. */
+static int parse_numbers(const char *s, int n, int ints, unsigned long *u, float *f)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        char *end = NULL;
+        while (is_space(*s)) {
+            ++s;
+        }
+        if (*s == '\0' || *s == '-' || *s == '+') {
+            return 0;
+        }
+        errno = 0;
+        if (ints) {
+            u[i] = strtoul(s, &end, 10);
+        } else {
+            f[i] = strtof(s, &end);
+        }
+        if (end == s || errno == ERANGE || (*end != '\0' && !is_space(*end))) {
+            return 0;
+        }
+        s = end;
+    }
+    while (is_space(*s)) {
+        ++s;
+    }
+    return *s == '\0';
+}
+
+umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out)
+{
+    umbra_status st = UMBRA_SUCCESS;
+    char *text = NULL, *raw_path = NULL, *line, *next;
+    void *buf = NULL;
+    size_t size = 0;
+    const char *object_file = NULL, *resolution = NULL, *thickness = NULL, *format = NULL;
+    unsigned long res[3] = {0, 0, 0};
+    umbra_raw_desc raw;
+    locale_switch loc;
+    int ok, i;
+
+    if (!out) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+    }
+    *out = NULL;
+    if (!ctx) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
+    }
+    st = umbra__read_file(ctx, __func__, path, &buf, &size);
+    if (st != UMBRA_SUCCESS) {
+        goto fail;
+    }
+    text = buf;
+    if (memchr(text, '\0', size)) {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" is not a text file (NUL byte)",
+                         __func__, path);
+        goto fail;
+    }
+
+    /* "Key: value" lines; unknown keys are ignored, a repeated key keeps its last value. Values
+     * point into text, cut at the end of their line. */
+    for (line = text; line; line = next) {
+        char *colon, *key, *key_end, *value, *value_end;
+        next = strchr(line, '\n');
+        if (next) {
+            *next++ = '\0';
+        }
+        colon = strchr(line, ':');
+        if (!colon) {
+            continue;
+        }
+        for (key = line; is_space(*key); ++key) {
+        }
+        for (key_end = colon; key_end > key && is_space(key_end[-1]); --key_end) {
+        }
+        for (value = colon + 1; is_space(*value); ++value) {
+        }
+        for (value_end = value + strlen(value); value_end > value && is_space(value_end[-1]);
+             --value_end) {
+        }
+        *value_end = '\0';
+        if (equal_nocase(key, (size_t)(key_end - key), "ObjectFileName")) {
+            object_file = value;
+        } else if (equal_nocase(key, (size_t)(key_end - key), "Resolution")) {
+            resolution = value;
+        } else if (equal_nocase(key, (size_t)(key_end - key), "SliceThickness")) {
+            thickness = value;
+        } else if (equal_nocase(key, (size_t)(key_end - key), "Format")) {
+            format = value;
+        } else if (equal_nocase(key, (size_t)(key_end - key), "ObjectModel")) {
+            if (!equal_nocase(value, strlen(value), "I")) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: \"%s\": ObjectModel \"%.*s\" is not supported (only I, one "
+                                 "scalar per voxel)",
+                                 __func__, path, QUOTE_MAX, value);
+                goto fail;
+            }
+        }
+    }
+    {
+        const char *keys[4] = {"ObjectFileName", "Resolution", "SliceThickness", "Format"};
+        const char *values[4];
+        values[0] = object_file;
+        values[1] = resolution;
+        values[2] = thickness;
+        values[3] = format;
+        for (i = 0; i < 4; ++i) {
+            if (!values[i] || values[i][0] == '\0') {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" has no value for key %s",
+                                 __func__, path, keys[i]);
+                goto fail;
+            }
+        }
+    }
+
+    umbra_raw_desc_init(&raw);
+    loc = locale_use_c();
+    ok = parse_numbers(resolution, 3, 1, res, NULL);
+    locale_restore(loc);
+    if (!ok || res[0] == 0 || res[1] == 0 || res[2] == 0 || res[0] > UINT32_MAX ||
+        res[1] > UINT32_MAX || res[2] > UINT32_MAX) {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\": Resolution \"%.*s\" is not three sizes > 0", __func__,
+                         path, QUOTE_MAX, resolution);
+        goto fail;
+    }
+    for (i = 0; i < 3; ++i) {
+        raw.dims[i] = (uint32_t)res[i];
+    }
+    loc = locale_use_c();
+    ok = parse_numbers(thickness, 3, 0, NULL, raw.spacing);
+    locale_restore(loc);
+    if (!ok || !(raw.spacing[0] > 0.0f) || !(raw.spacing[1] > 0.0f) ||
+        !(raw.spacing[2] > 0.0f) || !isfinite(raw.spacing[0]) || !isfinite(raw.spacing[1]) ||
+        !isfinite(raw.spacing[2])) {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\": SliceThickness \"%.*s\" is not three finite numbers > 0",
+                         __func__, path, QUOTE_MAX, thickness);
+        goto fail;
+    }
+    if (equal_nocase(format, strlen(format), "UCHAR")) {
+        raw.type = UMBRA_UINT8;
+    } else if (equal_nocase(format, strlen(format), "USHORT")) {
+        raw.type = UMBRA_UINT16;
+    } else if (equal_nocase(format, strlen(format), "SHORT")) {
+        raw.type = UMBRA_INT16;
+    } else if (equal_nocase(format, strlen(format), "FLOAT")) {
+        raw.type = UMBRA_FLOAT32;
+    } else {
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                         "%s: \"%s\": Format \"%.*s\" is not supported (UCHAR, USHORT, SHORT, "
+                         "FLOAT)",
+                         __func__, path, QUOTE_MAX, format);
+        goto fail;
+    }
+
+    /* The raw file is named relative to the directory of the .dat, unless absolute. */
+    if (object_file[0] == '/' || !strrchr(path, '/')) {
+        raw_path = malloc(strlen(object_file) + 1);
+        if (raw_path) {
+            strcpy(raw_path, object_file);
+        }
+    } else {
+        size_t dir_len = (size_t)(strrchr(path, '/') - path) + 1;
+        raw_path = malloc(dir_len + strlen(object_file) + 1);
+        if (raw_path) {
+            memcpy(raw_path, path, dir_len);
+            strcpy(raw_path + dir_len, object_file);
+        }
+    }
+    if (!raw_path) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory for \"%s\"",
+                         __func__, path);
+        goto fail;
+    }
+    st = load_raw(ctx, __func__, raw_path, &raw, out);
+
+fail:
+    free(raw_path);
+    free(buf);
+    return st;
+}
+
+/* ---- by extension ------------------------------------------------------------------------ */
+
+umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out)
+{
+    const char *ext;
+    if (!out) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+    }
+    *out = NULL;
+    if (!path) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
+    }
+    ext = path_extension(path);
+    if (equal_nocase(ext, strlen(ext), "nrrd") || equal_nocase(ext, strlen(ext), "nhdr")) {
+        return umbra_volume_load_nrrd(ctx, path, out);
+    }
+    if (equal_nocase(ext, strlen(ext), "dat")) {
+        return umbra_volume_load_dat(ctx, path, out);
+    }
+    return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                       "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD) and "
+                       ".dat (Voreen); load headerless raw files with umbra_volume_load_raw",
+                       __func__, path);
+}
