@@ -1,0 +1,566 @@
+/* host/shadow_deep.c: the deep shadow map (Hadwiger et al. 2006, after Lokovic and Veach 2000),
+ * host side. kernels/shadow_deep.cl has the algorithm; this module owns its device memory:
+ *
+ *   - the pre-compressed segment table (256 x 256 entries of 4 nodes), cached by what it depends
+ *     on -- the light transfer function, the light step, the number of light channels and the
+ *     transmission mode -- so a light move or a camera move never rebuilds it;
+ *   - the blocked map: a pool of blocks (K node layers of one tile each), a head index per tile,
+ *     a next index per block and a node count per texel. The pool is sized from the last build
+ *     (or two blocks per tile the first time); a build that asks for more blocks than the pool
+ *     holds is counted on the device, and the pool is re-allocated to exactly the count and the
+ *     build repeated, so no node is dropped (or, with growth disabled, the build fails with a
+ *     message giving both numbers);
+ *   - or, with a fixed node budget N (max_nodes > 0), a flat array of N nodes per texel.
+ * Memory reported: used blocks x block bytes + the layout (heads, used blocks' next indices,
+ * counts) + the table; for a fixed budget map_size^2 x N x node bytes + the table.
+ *
+ * The build kernels live in kernels/shadow_deep.cl next to the lookup but are compiled only into
+ * the build program (DEEP_BUILD_KERNELS), not into every ray caster program. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lightspace.h"
+#include "shadow_deep.h"
+
+typedef struct deep_state {
+    cl_program program;             /* owned by the context's cache */
+    cl_kernel k_lut, k_build, k_fixed;
+    uint32_t tile;                  /* chosen for k_build's work-group limit */
+
+    cl_mem lut;
+    uint64_t lut_key[4];            /* (light tf id, light step bits, channels, colored) */
+    int lut_valid;
+
+    cl_mem pool, next, head, counts, counter, fixed, dummy;
+    size_t pool_blocks, head_count, counts_count, fixed_bytes;
+    size_t block_bytes, node_bytes;
+    size_t used_blocks;
+    uint32_t tiles_per_row, block_size, channels, max_nodes, map_size;
+    int fixed_mode, lut_used;
+
+    size_t pool_override;           /* test knob: exact pool capacity, 0 = automatic */
+    int allow_growth;
+
+    uint64_t builds, build_passes, lut_builds, pool_growths;
+} deep_state;
+
+static float deep_light_step(const umbra_shadow_desc *d) { return d->map_step; }
+
+static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
+{
+    const char *fn = "umbra_renderer_set_shadow";
+    if (d->map_size < 16 || d->map_size > 8192)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep map_size %u must lie in [16, 8192]", fn, d->map_size);
+    if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep map_step %g voxels must lie in [0.01, 64]", fn, d->map_step);
+    if (!(d->epsilon >= 0.0f && d->epsilon <= 1.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep epsilon %g must lie in [0, 1]", fn, d->epsilon);
+    if (d->max_nodes == 1 || d->max_nodes > 64)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep max_nodes %u must be 0 (unbounded) or lie in [2, 64]", fn,
+                           d->max_nodes);
+    if (d->block_size < 1 || d->block_size > 256)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep block_size %u must lie in [1, 256]", fn, d->block_size);
+    if (d->prefilter != 1 && d->prefilter != 5)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: deep prefilter %u must be 1 or 5", fn, d->prefilter);
+    return UMBRA_SUCCESS;
+}
+
+static deep_state *state_get(umbra_renderer r)
+{
+    if (!r->tech_state) {
+        deep_state *s = calloc(1, sizeof *s);
+        if (!s)
+            return NULL;
+        s->allow_growth = 1;
+        r->tech_state = s;
+    }
+    return r->tech_state;
+}
+
+static void release_mem(cl_mem *m)
+{
+    if (*m)
+        clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+static void release_kernel(cl_kernel *k)
+{
+    if (*k)
+        clReleaseKernel(*k);
+    *k = NULL;
+}
+
+/* A device buffer, failing with a message that names what it is for. */
+static umbra_status create_buffer(umbra_context ctx, size_t bytes, const char *what, cl_mem *out)
+{
+    cl_ulong max_alloc = 0;
+    clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+    if (max_alloc && bytes > max_alloc)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "umbra_renderer_render: deep shadow map %s needs %zu bytes; the "
+                           "device allows %llu per buffer (use a smaller map_size, a larger "
+                           "epsilon or a node budget)", what, bytes, (unsigned long long)max_alloc);
+    cl_int err;
+    *out = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_WRITE, bytes ? bytes : 16, NULL, &err);
+    if (err != CL_SUCCESS) {
+        *out = NULL;
+        return umbra__fail(ctx,
+                           err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE
+                               ? UMBRA_ERROR_OUT_OF_MEMORY
+                               : UMBRA_ERROR_OPENCL,
+                           "umbra_renderer_render: deep shadow map %s (%zu bytes): clCreateBuffer "
+                           "failed with %s (%d)", what, bytes, umbra__cl_error_name(err), (int)err);
+    }
+    return UMBRA_SUCCESS;
+}
+
+/* The build program (kernels/shadow_deep.cl with its build kernels switched on, without the ray
+ * caster, so it does not depend on how the renderer assembles that one), its three kernels, and
+ * the tile edge the build's work-group size allows. */
+static umbra_status ensure_program(umbra_renderer r, deep_state *s)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "shadow_deep.cl"};
+    char options[300];
+    cl_program program;
+    umbra__build_options(r, options, sizeof options - 32);
+    strcat(options, " -DDEEP_BUILD_KERNELS=1");
+    if ((st = umbra__program_get(ctx, files, 4, options, &program)) != UMBRA_SUCCESS)
+        return st;
+    if (program == s->program && s->k_build)
+        return UMBRA_SUCCESS;
+    release_kernel(&s->k_lut);
+    release_kernel(&s->k_build);
+    release_kernel(&s->k_fixed);
+    s->program = NULL;
+    if ((st = umbra__kernel_create(ctx, program, "deep_lut", &s->k_lut)) ||
+        (st = umbra__kernel_create(ctx, program, "deep_build", &s->k_build)) ||
+        (st = umbra__kernel_create(ctx, program, "deep_build_fixed", &s->k_fixed)))
+        goto fail;
+    /* One work-group per tile: 16 x 16 as in the paper where the kernel and device allow 256
+     * work-items (PoCL's CPU device does), else 8 x 8. */
+    size_t kernel_wg = 0, device_wg = 0, item_sizes[3] = {0, 0, 0};
+    UMBRA_CL(clGetKernelWorkGroupInfo(s->k_build, ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
+                                      sizeof kernel_wg, &kernel_wg, NULL));
+    UMBRA_CL(clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof device_wg,
+                             &device_wg, NULL));
+    UMBRA_CL(clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_WORK_ITEM_SIZES, sizeof item_sizes,
+                             item_sizes, NULL));
+    size_t limit = kernel_wg < device_wg ? kernel_wg : device_wg;
+    size_t items = item_sizes[0] < item_sizes[1] ? item_sizes[0] : item_sizes[1];
+    if (limit >= 256 && items >= 16)
+        s->tile = 16;
+    else if (limit >= 64 && items >= 8)
+        s->tile = 8;
+    else {
+        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                         "umbra_renderer_render: the deep map build needs work-groups of 8 x 8 "
+                         "work-items; this device allows %zu (kernel) / %zu (device)",
+                         kernel_wg, device_wg);
+        goto fail;
+    }
+    s->program = program;
+    return UMBRA_SUCCESS;
+fail:
+    release_kernel(&s->k_lut);
+    release_kernel(&s->k_build);
+    release_kernel(&s->k_fixed);
+    return st;
+}
+
+static umbra_status run_kernel(umbra_renderer r, cl_kernel k, const size_t global[2],
+                               const size_t *local, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    cl_event ev = NULL;
+    double t0 = umbra__now_ms();
+    if ((st = umbra__enqueue(ctx, k, 2, global, local, &ev)) != UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clWaitForEvents(1, &ev));
+    double t = umbra__event_ms(ev);
+    *ms += t >= 0.0 ? t : umbra__now_ms() - t0;
+fail:
+    if (ev)
+        clReleaseEvent(ev);
+    return st;
+}
+
+/* The segment table for the current light table, rebuilt only when its key changed. */
+static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    float step = r->shadow.map_step;
+    uint32_t step_bits;
+    memcpy(&step_bits, &step, sizeof step_bits);
+    uint64_t key[4] = {umbra__light_tf(r)->id, step_bits, r->channels,
+                       r->opts.transmission == UMBRA_TRANSMISSION_COLORED};
+    if (s->lut && s->lut_valid && memcmp(key, s->lut_key, sizeof key) == 0)
+        return UMBRA_SUCCESS;
+    s->lut_valid = 0;
+    release_mem(&s->lut);
+    size_t bytes = (size_t)UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_NODES *
+                   s->node_bytes;
+    if ((st = create_buffer(ctx, bytes, "segment table", &s->lut)) != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clSetKernelArg(s->k_lut, 0, sizeof(cl_mem), &r->frame_buf));
+    UMBRA_CL(clSetKernelArg(s->k_lut, 1, sizeof(cl_mem), &r->light_tf_buf));
+    UMBRA_CL(clSetKernelArg(s->k_lut, 2, sizeof(cl_mem), &s->lut));
+    size_t global[2] = {UMBRA__DEEP_LUT_RES, UMBRA__DEEP_LUT_RES};
+    if ((st = run_kernel(r, s->k_lut, global, NULL, ms)) != UMBRA_SUCCESS)
+        goto fail;
+    memcpy(s->lut_key, key, sizeof key);
+    s->lut_valid = 1;
+    s->lut_builds++;
+fail:
+    return st;
+}
+
+/* Arguments shared by deep_build and deep_build_fixed after the common ones; returns the next
+ * index through *next. */
+static umbra_status bind_march(umbra_renderer r, deep_state *s, cl_kernel k, cl_uint *next)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = umbra__bind_common(r, k, next);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    cl_uint use_lut = s->lut_used ? 1u : 0u, prefilter = r->shadow.prefilter;
+    float eps = r->shadow.epsilon;
+    cl_mem lut = s->lut_used ? s->lut : s->dummy;
+    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &lut));
+    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof use_lut, &use_lut));
+    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof prefilter, &prefilter));
+    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof eps, &eps));
+fail:
+    return st;
+}
+
+static umbra_status ensure_size(umbra_context ctx, cl_mem *buf, size_t *have, size_t want,
+                                const char *what)
+{
+    if (*buf && *have == want)
+        return UMBRA_SUCCESS;
+    release_mem(buf);
+    *have = 0;
+    umbra_status st = create_buffer(ctx, want, what, buf);
+    if (st == UMBRA_SUCCESS)
+        *have = want;
+    return st;
+}
+
+static umbra_status alloc_pool(umbra_context ctx, deep_state *s, size_t blocks)
+{
+    release_mem(&s->pool);
+    release_mem(&s->next);
+    s->pool_blocks = 0;
+    umbra_status st = create_buffer(ctx, blocks * s->block_bytes, "block pool", &s->pool);
+    if (st == UMBRA_SUCCESS)
+        st = create_buffer(ctx, blocks * sizeof(cl_int), "block links", &s->next);
+    if (st == UMBRA_SUCCESS)
+        s->pool_blocks = blocks;
+    return st;
+}
+
+static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const uint32_t n = r->shadow.map_size, T = s->tile;
+    const size_t tiles = (size_t)s->tiles_per_row * s->tiles_per_row;
+    size_t have_counter = s->counter ? sizeof(cl_uint) : 0;
+    if ((st = ensure_size(ctx, &s->head, &s->head_count, tiles * sizeof(cl_int), "tile heads")) ||
+        (st = ensure_size(ctx, &s->counts, &s->counts_count, (size_t)n * n * sizeof(cl_uint),
+                          "node counts")) ||
+        (st = ensure_size(ctx, &s->counter, &have_counter, sizeof(cl_uint), "block counter")))
+        return st;
+    /* Pool: the knob's size, else room for the last build plus an eighth, else two blocks a tile;
+     * it only grows, so a light moving back and forth does not re-allocate. */
+    size_t want = s->pool_override ? s->pool_override
+                  : s->used_blocks ? s->used_blocks + s->used_blocks / 8 + 1
+                                   : 2 * tiles;
+    if (!s->pool || (s->pool_override ? s->pool_blocks != want : s->pool_blocks < want))
+        if ((st = alloc_pool(ctx, s, want)) != UMBRA_SUCCESS)
+            return st;
+    for (int attempt = 0;; ++attempt) {
+        const cl_uint zero = 0, capacity = (cl_uint)s->pool_blocks;
+        cl_uint next = 0, used = 0;
+        UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, s->counter, CL_TRUE, 0, sizeof zero, &zero, 0,
+                                      NULL, NULL));
+        if ((st = bind_march(r, s, s->k_build, &next)) != UMBRA_SUCCESS)
+            return st;
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->pool));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->head));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->next));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->counts));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->counter));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof capacity, &capacity));
+        size_t global[2] = {(size_t)s->tiles_per_row * T, (size_t)s->tiles_per_row * T};
+        size_t local[2] = {T, T};
+        if ((st = run_kernel(r, s->k_build, global, local, ms)) != UMBRA_SUCCESS)
+            return st;
+        s->build_passes++;
+        UMBRA_CL(clEnqueueReadBuffer(ctx->queue, s->counter, CL_TRUE, 0, sizeof used, &used, 0,
+                                     NULL, NULL));
+        if (used <= capacity) {
+            s->used_blocks = used;
+            break;
+        }
+        /* The count is deterministic (each tile's chain length depends only on its texels), so
+         * one re-allocation to exactly the count always suffices. */
+        if (!s->allow_growth || attempt >= 2)
+            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                               "umbra_renderer_render: the deep shadow map needs %u blocks of "
+                               "%zu bytes but the pool holds %u and may not grow", used,
+                               s->block_bytes, capacity);
+        if ((st = alloc_pool(ctx, s, used)) != UMBRA_SUCCESS)
+            return st;
+        s->pool_growths++;
+    }
+fail:
+    return st;
+}
+
+static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const uint32_t n = r->shadow.map_size;
+    size_t bytes = (size_t)n * n * r->shadow.max_nodes * s->node_bytes;
+    if ((st = ensure_size(ctx, &s->fixed, &s->fixed_bytes, bytes, "node array")) != UMBRA_SUCCESS)
+        return st;
+    cl_uint next = 0;
+    if ((st = bind_march(r, s, s->k_fixed, &next)) != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clSetKernelArg(s->k_fixed, next++, sizeof(cl_mem), &s->fixed));
+    size_t global[2] = {n, n};
+    st = run_kernel(r, s->k_fixed, global, NULL, ms);
+    if (st == UMBRA_SUCCESS)
+        s->build_passes++;
+fail:
+    return st;
+}
+
+static umbra_status deep_build(umbra_renderer r, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    deep_state *s = state_get(r);
+    if (!s)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
+    const umbra_shadow_desc *d = &r->shadow;
+    if ((st = ensure_program(r, s)) != UMBRA_SUCCESS)
+        return st;
+    UmbraShadow *S = &r->shadow_params;
+    umbra__lightspace_setup(r, d->map_size);
+    S->epsilon = d->epsilon;
+    S->block_size = d->block_size;
+    S->max_nodes = d->max_nodes;
+    S->depth_bias = 0.0f;
+    S->deep_tile = s->tile;
+    S->tiles_per_row = (d->map_size + s->tile - 1) / s->tile;
+    if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS)
+        return st;
+    s->tiles_per_row = S->tiles_per_row;
+    s->block_size = d->block_size;
+    s->channels = r->channels;
+    s->max_nodes = d->max_nodes;
+    s->map_size = d->map_size;
+    s->node_bytes = sizeof(float) * (1u + r->channels);
+    s->block_bytes = (size_t)d->block_size * s->tile * s->tile * s->node_bytes;
+    if (!s->dummy && (st = create_buffer(ctx, 16, "placeholder", &s->dummy)) != UMBRA_SUCCESS)
+        return st;
+    s->lut_used = d->lookup_table != 0;
+    if (s->lut_used) {
+        if ((st = ensure_lut(r, s, ms)) != UMBRA_SUCCESS)
+            return st;
+    }
+    /* Without the table a cached one is kept (turning the option back on must not rebuild it)
+     * but not counted: memory() reports what the map uses. */
+    s->fixed_mode = d->max_nodes > 0;
+    if (s->fixed_mode) {
+        release_mem(&s->pool);
+        release_mem(&s->next);
+        s->pool_blocks = s->used_blocks = 0;
+        st = build_fixed(r, s, ms);
+    } else {
+        release_mem(&s->fixed);
+        s->fixed_bytes = 0;
+        st = build_blocked(r, s, ms);
+    }
+    if (st == UMBRA_SUCCESS)
+        s->builds++;
+    return st;
+}
+
+static umbra_status deep_bind(umbra_renderer r, cl_kernel k, cl_uint first)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    deep_state *s = r->tech_state;
+    if (!s || !s->dummy || (s->fixed_mode ? !s->fixed : !s->pool))
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_render: the deep shadow map has not been built");
+    cl_mem args[4] = {s->fixed_mode ? s->fixed : s->pool, s->fixed_mode ? s->dummy : s->head,
+                      s->fixed_mode ? s->dummy : s->next, s->fixed_mode ? s->dummy : s->counts};
+    for (cl_uint i = 0; i < 4; ++i)
+        UMBRA_CL(clSetKernelArg(k, first + i, sizeof(cl_mem), &args[i]));
+fail:
+    return st;
+}
+
+static size_t lut_bytes(const deep_state *s)
+{
+    return s->lut_used && s->lut ? (size_t)UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_RES *
+                                       UMBRA__DEEP_LUT_NODES * s->node_bytes
+                                 : 0;
+}
+
+static size_t map_bytes(const deep_state *s)
+{
+    return s->fixed_mode ? s->fixed_bytes : s->used_blocks * s->block_bytes;
+}
+
+static size_t layout_bytes(const deep_state *s)
+{
+    if (s->fixed_mode)
+        return 0;
+    return (size_t)s->tiles_per_row * s->tiles_per_row * sizeof(cl_int) +
+           s->used_blocks * sizeof(cl_int) + (size_t)s->map_size * s->map_size * sizeof(cl_uint);
+}
+
+static size_t deep_memory(umbra_renderer r)
+{
+    const deep_state *s = r->tech_state;
+    if (!s || s->builds == 0)
+        return 0;
+    return map_bytes(s) + layout_bytes(s) + lut_bytes(s);
+}
+
+static void deep_destroy(umbra_renderer r)
+{
+    deep_state *s = r->tech_state;
+    if (!s)
+        return;
+    release_kernel(&s->k_lut);
+    release_kernel(&s->k_build);
+    release_kernel(&s->k_fixed);
+    cl_mem *mems[] = {&s->lut, &s->pool, &s->next, &s->head, &s->counts, &s->counter, &s->fixed,
+                      &s->dummy};
+    for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
+        release_mem(mems[i]);
+    free(s);
+    r->tech_state = NULL;
+}
+
+const umbra__technique umbra__technique_deep = {
+    .id = UMBRA_SHADOW_DEEP,
+    .kernel_file = "shadow_deep.cl",
+    .light_step = deep_light_step,
+    .validate = deep_validate,
+    .build = deep_build,
+    .bind = deep_bind,
+    .memory = deep_memory,
+    .destroy = deep_destroy,
+};
+
+/* ---- internals for the tests ----------------------------------------------------------------- */
+
+static umbra_status check_deep(umbra_renderer r, const char *fn)
+{
+    if (!r)
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    if (r->tech != &umbra__technique_deep)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: the renderer's technique is '%s', not 'deep'", fn,
+                           umbra_shadow_technique_name(r->tech->id));
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__deep_get_info(umbra_renderer r, umbra__deep_info *out)
+{
+    umbra_status st = check_deep(r, "umbra__deep_get_info");
+    if (st != UMBRA_SUCCESS)
+        return st;
+    memset(out, 0, sizeof *out);
+    const deep_state *s = r->tech_state;
+    if (!s)
+        return UMBRA_SUCCESS;
+    out->tile = s->tile;
+    out->tiles_per_row = s->tiles_per_row;
+    out->block_size = s->block_size;
+    out->channels = s->channels;
+    out->max_nodes = s->fixed_mode ? s->max_nodes : 0;
+    out->node_bytes = s->node_bytes;
+    out->block_bytes = s->block_bytes;
+    out->pool_blocks = s->pool_blocks;
+    out->used_blocks = s->used_blocks;
+    out->map_bytes = map_bytes(s);
+    out->layout_bytes = layout_bytes(s);
+    out->lut_bytes = lut_bytes(s);
+    out->builds = s->builds;
+    out->build_passes = s->build_passes;
+    out->lut_builds = s->lut_builds;
+    out->pool_growths = s->pool_growths;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__deep_set_pool(umbra_renderer r, size_t blocks, int allow_growth)
+{
+    umbra_status st = check_deep(r, "umbra__deep_set_pool");
+    if (st != UMBRA_SUCCESS)
+        return st;
+    deep_state *s = state_get(r);
+    if (!s)
+        return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "umbra__deep_set_pool: out of memory");
+    s->pool_override = blocks;
+    s->allow_growth = allow_growth;
+    r->built_valid = 0;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__deep_read(umbra_renderer r, int32_t *head, int32_t *next, uint32_t *counts,
+                              float *nodes)
+{
+    umbra_status st = check_deep(r, "umbra__deep_read");
+    if (st != UMBRA_SUCCESS)
+        return st;
+    umbra_context ctx = r->ctx;
+    const deep_state *s = r->tech_state;
+    if (!s || s->builds == 0)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra__deep_read: the deep shadow map has not been built");
+    cl_command_queue q = ctx->queue;
+    if (s->fixed_mode) {
+        if (head || next || counts)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "umbra__deep_read: a fixed-budget map has no block layout");
+        if (nodes)
+            UMBRA_CL(clEnqueueReadBuffer(q, s->fixed, CL_TRUE, 0, s->fixed_bytes, nodes, 0, NULL,
+                                         NULL));
+        return UMBRA_SUCCESS;
+    }
+    if (head)
+        UMBRA_CL(clEnqueueReadBuffer(q, s->head, CL_TRUE, 0, s->head_count, head, 0, NULL, NULL));
+    if (next && s->used_blocks)
+        UMBRA_CL(clEnqueueReadBuffer(q, s->next, CL_TRUE, 0, s->used_blocks * sizeof(cl_int), next,
+                                     0, NULL, NULL));
+    if (counts)
+        UMBRA_CL(clEnqueueReadBuffer(q, s->counts, CL_TRUE, 0, s->counts_count, counts, 0, NULL,
+                                     NULL));
+    if (nodes && s->used_blocks)
+        UMBRA_CL(clEnqueueReadBuffer(q, s->pool, CL_TRUE, 0, s->used_blocks * s->block_bytes,
+                                     nodes, 0, NULL, NULL));
+fail:
+    return st;
+}

@@ -1,0 +1,766 @@
+/* kernels/shadow_deep.cl: deep shadow maps for volume ray casting (Hadwiger, Kratz, Sigg and
+ * Buehler 2006, after Lokovic and Veach 2000). Three build stages, compiled (DEEP_BUILD_KERNELS=1)
+ * into the build program of host/shadow_deep.c:
+ *
+ *   deep_lut          the pre-compressed segment table: for every pair of successive quantised
+ *                     light-ray samples (s_f, s_b) the visibility of the segment between them,
+ *                     integrated from the light transfer function at DEEP_LUT_SUBSTEPS sub-steps
+ *                     (the scalar taken to vary linearly from s_f to s_b) and compressed to at
+ *                     most DEEP_LUT_INTERIOR interior nodes plus the exact end value;
+ *   deep_build        the map in blocks: one work-group per tile of deep_tile^2 texels; per
+ *                     texel, light rays (1, or 5 pre-filtered sub-texel rays) march along a depth
+ *                     grid, their visibility is compressed greedily within epsilon, and the nodes
+ *                     are written into blocks of block_size node layers that the tile takes from a
+ *                     pool with an atomic counter;
+ *   deep_build_fixed  the same march with a fixed budget of max_nodes nodes per texel in a flat
+ *                     array (for comparisons at equal memory, as in the CSSM paper);
+ * and the lookup (SHADOW_FACTOR) the ray caster calls for every sample, which is all the ray
+ * caster's program compiles of this file.
+ *
+ * A node is (normalised depth, visibility per light channel): float2 with one light channel,
+ * float4 (depth, r, g, b) with three. All channels share the node depths, as in Lokovic and
+ * Veach's coloured deep shadow maps and in the CSSM paper's count of "four values per node". The
+ * visibility before the first node is 1, between nodes linear, after the last node constant.
+ *
+ * Depth grid. Every light ray is cut into segments [t_k, t_k + h] (h = S->step) whose ends lie at
+ * normalised depths k * h / (far - near): the same depth planes for every texel and sub-ray, so
+ * the pre-filtered sub-rays can be combined segment by segment and no texel gets its own sampling
+ * phase. A segment fully inside the box is integrated with the lookup table from the scalars at its
+ * two ends, or (lookup_table = 0) with one sample at its midpoint -- the midpoint rule the exact
+ * reference (kernels/shadow_reference.cl) uses, so a homogeneous medium gives exp(-sigma d) at
+ * every node with or without the table. The partial segments where a ray enters or leaves the box
+ * always use the midpoint rule with the opacity re-corrected for their length. */
+
+#ifndef DEEP_BUILD_KERNELS
+#define DEEP_BUILD_KERNELS 0 /* the host's build program sets 1; the ray caster needs the lookup */
+#endif
+
+/* Must match host/shadow_deep.h. */
+#define DEEP_LUT_RES 256          /* quantised scalar values per table axis */
+#define DEEP_LUT_INTERIOR 3       /* interior nodes per table entry, at most */
+#define DEEP_LUT_NODES (DEEP_LUT_INTERIOR + 1) /* stored per entry: interior nodes + the end */
+#define DEEP_LUT_SUBSTEPS 64      /* integration sub-steps per segment when building the table */
+#define DEEP_LUT_TOL 1e-3f        /* an entry's tolerance when its node budget allows */
+#define DEEP_MAX_SUB 5            /* sub-texel rays per texel */
+#define DEEP_MAX_POINTS (DEEP_MAX_SUB * DEEP_LUT_NODES) /* distinct positions in one segment */
+#define DEEP_MAX_EMIT (DEEP_MAX_POINTS + 6) /* nodes one march step can emit (see deep_step) */
+
+#if UMBRA_LIGHT_CHANNELS == 1
+typedef float2 deep_node;
+#define DEEP_DEPTH(n) ((n).x)
+#define DEEP_VIS(n) ((n).y)
+#define DEEP_NODE(z, v) ((float2)((z), (v)))
+inline int deep_any_gt(float a, float b) { return a > b; }
+inline int deep_all_one(float v) { return v >= 1.0f; }
+inline float deep_max_abs(float v) { return fabs(v); }
+#else
+typedef float4 deep_node;
+#define DEEP_DEPTH(n) ((n).x)
+#define DEEP_VIS(n) ((n).yzw)
+#define DEEP_NODE(z, v) ((float4)((z), (v)))
+inline int deep_any_gt(float3 a, float3 b) { return any(a > b); }
+inline int deep_all_one(float3 v) { return all(v >= (float3)(1.0f)); }
+inline float deep_max_abs(float3 v) { return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z))); }
+#endif
+
+#if DEEP_BUILD_KERNELS
+/* ---- greedy compression (Lokovic and Veach's cone of slopes) ---------------------------------
+ * A segment starts at the last emitted node (z0, v0). Every point fed afterwards narrows, per
+ * channel, the interval [lo, hi] of slopes whose line from the origin passes within tol of it.
+ * When a point would leave some channel's interval empty, the segment ends at the previous
+ * point: its node gets, per channel, the slope nearest to the exact one through that point
+ * (clamped into the interval), so every point of the segment stays within tol, and the next
+ * segment starts there. Points are held back by one, so that the last point of a ray is fed with
+ * tolerance 0: the visibility behind the volume (the ground plane's shadow) is exact.
+ * Until the visibility first drops below 1 the origin slides along with the points, so empty
+ * space in front of the first attenuation costs no node (the paper's "implicit" skipping). */
+typedef struct DeepFit {
+    float z0, zl, zh;          /* origin depth, last fed point's depth, held point's depth */
+    light_t v0, vl, vh, lo, hi;
+    int npts;                  /* points fed since the origin */
+    int started;               /* the origin node has been emitted */
+    int held;                  /* a point is held back */
+} DeepFit;
+
+inline void deep_fit_init(DeepFit *f)
+{
+    f->z0 = f->zl = f->zh = 0.0f;
+    f->v0 = f->vl = f->vh = (light_t)(1.0f);
+    f->lo = f->hi = (light_t)(0.0f);
+    f->npts = 0;
+    f->started = 0;
+    f->held = 0;
+}
+
+/* The node that ends the current segment at the last fed point. */
+inline deep_node deep_fit_close(const DeepFit *f)
+{
+    float dz = f->zl - f->z0;
+    light_t s = clamp((f->vl - f->v0) / dz, f->lo, f->hi);
+    light_t v = clamp(f->v0 + s * dz, (light_t)(0.0f), (light_t)(1.0f));
+    return DEEP_NODE(f->zl, v);
+}
+
+/* The slopes from the origin whose line passes within tol of (z0 + dz, v) and stays inside
+ * [0, 1] there. The second condition keeps every node in [0, 1] without clamping a node after
+ * the fact (which would move the line by more than tol at the points before it); a point's own
+ * window always meets [0, 1], since v does. */
+inline void deep_fit_window(const DeepFit *f, float dz, light_t v, float tol, light_t *lo,
+                            light_t *hi)
+{
+    *lo = fmax(v - tol, (light_t)(0.0f));
+    *hi = fmin(v + tol, (light_t)(1.0f));
+    *lo = (*lo - f->v0) / dz;
+    *hi = (*hi - f->v0) / dz;
+}
+
+/* Feeds one point with tolerance tol; appends emitted nodes to e[*n] (at most 2). */
+inline void deep_fit_feed(DeepFit *f, float z, light_t v, float tol, deep_node *e, int *n)
+{
+    if (!f->started) {
+        if (deep_all_one(v)) {
+            f->z0 = z;
+            return;
+        }
+        f->started = 1;
+        f->v0 = (light_t)(1.0f);
+        f->npts = 0;
+        e[(*n)++] = DEEP_NODE(f->z0, f->v0);
+    }
+    /* Depths increase strictly by construction; a rounding tie would divide by zero. */
+    z = fmax(z, f->z0 + 1e-7f * (1.0f + fabs(f->z0)));
+    float dz = z - f->z0;
+    light_t lo, hi;
+    deep_fit_window(f, dz, v, tol, &lo, &hi);
+    if (f->npts > 0) {
+        light_t nlo = fmax(lo, f->lo), nhi = fmin(hi, f->hi);
+        if (deep_any_gt(nlo, nhi)) {
+            deep_node c = deep_fit_close(f);
+            e[(*n)++] = c;
+            f->z0 = DEEP_DEPTH(c);
+            f->v0 = DEEP_VIS(c);
+            f->npts = 0;
+            z = fmax(z, f->z0 + 1e-7f * (1.0f + fabs(f->z0)));
+            dz = z - f->z0;
+            deep_fit_window(f, dz, v, tol, &lo, &hi);
+        } else {
+            lo = nlo;
+            hi = nhi;
+        }
+    }
+    f->lo = lo;
+    f->hi = hi;
+    f->zl = z;
+    f->vl = v;
+    f->npts++;
+}
+
+/* Adds a point (the previously held one is fed now with tolerance eps). */
+inline void deep_fit_push(DeepFit *f, float z, light_t v, float eps, deep_node *e, int *n)
+{
+    if (f->held)
+        deep_fit_feed(f, f->zh, f->vh, eps, e, n);
+    f->zh = z;
+    f->vh = v;
+    f->held = 1;
+}
+
+/* Ends the function: the held point exactly, then the node closing the last segment (at most 3
+ * nodes). A ray whose visibility never dropped emits nothing. */
+inline void deep_fit_finish(DeepFit *f, deep_node *e, int *n)
+{
+    if (f->held)
+        deep_fit_feed(f, f->zh, f->vh, 0.0f, e, n);
+    f->held = 0;
+    if (f->started && f->npts > 0)
+        e[(*n)++] = deep_fit_close(f);
+    f->npts = 0;
+}
+
+/* ---- the pre-compressed segment table -------------------------------------------------------
+ * Entry (i_f, i_b) covers a segment of one light step h whose scalar runs linearly from
+ * s_f = i_f / (R-1) to s_b = i_b / (R-1). Its visibility is integrated at DEEP_LUT_SUBSTEPS
+ * midpoint sub-steps with the (h-corrected) light table re-corrected to h / DEEP_LUT_SUBSTEPS,
+ * then compressed with the fit above within DEEP_LUT_TOL, or, where that needs more than
+ * DEEP_LUT_INTERIOR interior nodes, within the smallest tolerance that needs no more. The end
+ * value is exact (the fit pins the last point). Stored: DEEP_LUT_NODES nodes (x in (0, 1],
+ * visibility factor), the last one at x = 1; unused interior slots repeat the end node.
+ * Global size R x R; F supplies the light table size and the colour flag. */
+inline int deep_lut_fit(const light_t *v, float tol, int limit, deep_node *out)
+{
+    DeepFit f;
+    deep_fit_init(&f); /* origin (0, 1): the segment start, implicit in the table */
+    deep_node e[3];
+    int count = 0;
+    for (int j = 1; j <= DEEP_LUT_SUBSTEPS; ++j) {
+        int n = 0;
+        deep_fit_push(&f, (float)j / (float)DEEP_LUT_SUBSTEPS, v[j], tol, e, &n);
+        if (j == DEEP_LUT_SUBSTEPS)
+            deep_fit_finish(&f, e, &n);
+        for (int q = 0; q < n; ++q) {
+            /* The fit's first node is the last point at visibility 1 (an isosurface's front,
+             * kept exactly, so nothing in front of it is shadowed); at x = 0 it is implicit. */
+            if (DEEP_DEPTH(e[q]) <= 0.0f)
+                continue;
+            if (out && count < DEEP_LUT_NODES)
+                out[count] = e[q];
+            ++count;
+        }
+        /* The last point always adds the end node: more than limit + 1 cannot fit. */
+        if (count > limit + (j == DEEP_LUT_SUBSTEPS))
+            return count;
+    }
+    return count - 1; /* the last node is the end, at x = 1 */
+}
+
+__kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *light_tf,
+                       __global deep_node *lut)
+{
+    const int i_f = get_global_id(0), i_b = get_global_id(1);
+    if (i_f >= DEEP_LUT_RES || i_b >= DEEP_LUT_RES)
+        return;
+    const float sf = (float)i_f / (float)(DEEP_LUT_RES - 1);
+    const float sb = (float)i_b / (float)(DEEP_LUT_RES - 1);
+    const uint n_tf = F->light_tf_size, flags = F->flags;
+    const float frac = 1.0f / (float)DEEP_LUT_SUBSTEPS;
+    light_t v[DEEP_LUT_SUBSTEPS + 1];
+    v[0] = (light_t)(1.0f);
+    for (int j = 0; j < DEEP_LUT_SUBSTEPS; ++j) {
+        float s = mix(sf, sb, ((float)j + 0.5f) * frac);
+        float4 c = tf_lookup(light_tf, n_tf, s);
+        /* alpha_for_fraction(c, frac), with the fast exp2 / log2: this loop is the table's cost */
+        c.w = 1.0f - native_exp2(native_log2(fmax(1.0f - c.w, 0.0f)) * frac);
+        v[j + 1] = v[j] * light_pass(c, flags);
+    }
+    deep_node out[DEEP_LUT_NODES];
+    const light_t end = v[DEEP_LUT_SUBSTEPS];
+    for (int q = 0; q < DEEP_LUT_NODES; ++q)
+        out[q] = DEEP_NODE(1.0f, end);
+    if (!deep_all_one(end)) {
+        /* As few nodes as keep the entry within DEEP_LUT_TOL (a smooth segment needs none, so
+         * the map's fit gets one point per step there); where that takes more than
+         * DEEP_LUT_INTERIOR (a sharp feature), the smallest tolerance that needs no more, by
+         * bisection between DEEP_LUT_TOL and the error of the straight line from 1 to the end
+         * value (which needs none): 8 halvings, within 1/256 of that error of the optimum for
+         * this greedy fit. */
+        float hi = DEEP_LUT_TOL;
+        if (deep_lut_fit(v, DEEP_LUT_TOL, DEEP_LUT_INTERIOR, 0) > DEEP_LUT_INTERIOR) {
+            float lo = DEEP_LUT_TOL;
+            for (int j = 1; j < DEEP_LUT_SUBSTEPS; ++j) {
+                float x = (float)j / (float)DEEP_LUT_SUBSTEPS;
+                hi = fmax(hi, deep_max_abs(v[j] - mix((light_t)(1.0f), end, x)));
+            }
+            hi = hi * 1.001f + 1e-6f; /* rounding must not make the straight line infeasible */
+            for (int it = 0; it < 8; ++it) {
+                float mid = 0.5f * (lo + hi);
+                if (deep_lut_fit(v, mid, DEEP_LUT_INTERIOR, 0) <= DEEP_LUT_INTERIOR)
+                    hi = mid;
+                else
+                    lo = mid;
+            }
+        }
+        int interior = deep_lut_fit(v, hi, DEEP_LUT_NODES, out);
+        interior = min(interior, DEEP_LUT_INTERIOR);
+        out[interior] = DEEP_NODE(1.0f, end);
+        for (int q = interior + 1; q < DEEP_LUT_NODES; ++q)
+            out[q] = out[interior];
+    }
+    __global deep_node *dst = lut + ((size_t)i_f * DEEP_LUT_RES + (size_t)i_b) * DEEP_LUT_NODES;
+    for (int q = 0; q < DEEP_LUT_NODES; ++q)
+        dst[q] = out[q];
+}
+
+/* ---- the light-ray march --------------------------------------------------------------------
+ * Pre-filter (desc->prefilter = 5): the paper casts several sub-pixel rays per texel and
+ * combines their samples, but gives neither positions nor weights. We use the quincunx kernel:
+ * the texel centre with weight 1/2 and its four corners with weight 1/8 each, a 5-tap
+ * approximation of a tent filter one texel in radius (each corner ray is shared in weight with
+ * the three neighbours that touch it). The combined visibility is the weighted sum of the
+ * sub-rays' piecewise linear visibilities, evaluated exactly at the union of their node positions
+ * within each segment. */
+__constant float4 deep_taps[DEEP_MAX_SUB] = {
+    (float4)(0.0f, 0.0f, 0.5f, 0.0f),    (float4)(-0.5f, -0.5f, 0.125f, 0.0f),
+    (float4)(0.5f, -0.5f, 0.125f, 0.0f), (float4)(-0.5f, 0.5f, 0.125f, 0.0f),
+    (float4)(0.5f, 0.5f, 0.125f, 0.0f)};
+
+typedef struct DeepSub {
+    float3 o, d;
+    float ta, tb;   /* where the ray is inside the box */
+    float w;        /* filter weight */
+    float s_prev;   /* scalar at the current segment's front end, if has_prev */
+    int has_prev;
+    light_t v;      /* visibility at the current segment's front end */
+} DeepSub;
+
+typedef struct DeepTexel {
+    DeepSub sub[DEEP_MAX_SUB];
+    int nsub;
+    int k, k_end;     /* current segment, one past the last */
+    float base;       /* ray parameter of depth 0 */
+    float zstep;      /* normalised depth per segment */
+    float z_pushed;   /* depth of the last point given to the fit */
+    float eps, v_stop;
+    int done;
+    DeepFit fit;
+} DeepTexel;
+
+inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom g, int2 texel,
+                            uint prefilter, float eps)
+{
+    const float h = S->step;
+    float ta_min = UMBRA_INF, tb_max = -UMBRA_INF;
+    T->nsub = 0;
+    T->base = 0.0f;
+    for (uint i = 0; i < prefilter && i < DEEP_MAX_SUB; ++i) {
+        float4 tap = prefilter == 1u ? (float4)(0.0f, 0.0f, 1.0f, 0.0f) : deep_taps[i];
+        float2 xy = convert_float2(texel) + 0.5f + tap.xy;
+        float3 o, d;
+        float2 t = ls_texel_ray(S, g, xy, &o, &d);
+        if (i == 0)
+            T->base = S->near_far[0] - (S->ls_mode == UMBRA_LS_ORTHO ? dot(o, F3(S->ls_w)) : 0.0f);
+        DeepSub *s = &T->sub[T->nsub++];
+        s->o = o;
+        s->d = d;
+        s->w = tap.z;
+        s->v = (light_t)(1.0f);
+        s->has_prev = 0;
+        s->s_prev = 0.0f;
+        /* A ray that misses (or grazes) the box keeps an empty interval and its weight: lit. */
+        s->ta = t.x;
+        s->tb = (t.y > t.x && isfinite(t.x) && isfinite(t.y)) ? t.y : t.x;
+        if (s->tb > s->ta) {
+            ta_min = fmin(ta_min, s->ta);
+            tb_max = fmax(tb_max, s->tb);
+        }
+    }
+    T->zstep = h * S->near_far[2];
+    T->eps = eps;
+    T->v_stop = fmax(0.5f * eps, 1e-4f);
+    T->z_pushed = -UMBRA_INF;
+    deep_fit_init(&T->fit);
+    T->done = !(tb_max > ta_min);
+    T->k = T->k_end = 0;
+    if (!T->done) {
+        T->k = (int)floor((ta_min - T->base) / h);
+        T->k_end = (int)ceil((tb_max - T->base) / h);
+        T->k = max(T->k, 0);
+        T->done = T->k >= T->k_end;
+    }
+}
+
+/* A sub-ray's visibility within the current segment: (x, v) points after the implicit (0, v0),
+ * constant after the last. */
+typedef struct DeepPoints {
+    float x[DEEP_LUT_NODES];
+    light_t v[DEEP_LUT_NODES];
+    int n;
+} DeepPoints;
+
+inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
+{
+    float xp = 0.0f;
+    light_t vp = v0;
+    for (int j = 0; j < p->n; ++j) {
+        if (x <= p->x[j]) {
+            float w = p->x[j] > xp ? (x - xp) / (p->x[j] - xp) : 1.0f;
+            return mix(vp, p->v[j], clamp(w, 0.0f, 1.0f));
+        }
+        xp = p->x[j];
+        vp = p->v[j];
+    }
+    return vp;
+}
+
+inline int deep_quant(float s)
+{
+    return (int)(clamp(s, 0.0f, 1.0f) * (float)(DEEP_LUT_RES - 1) + 0.5f);
+}
+
+/* Marches one segment (or jumps over empty bricks) and feeds the fit; writes the emitted nodes
+ * to e and returns their number (at most DEEP_MAX_EMIT: one per distinct position, one for the
+ * gap point, one for the fit's first node, three when the ray ends). Sets T->done at the end. */
+inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
+                     __global const float4 *light_tf, __global const uchar *light_bricks,
+                     __global const UmbraShadow *S, __global const deep_node *lut, uint use_lut,
+                     deep_node *e)
+{
+    int ne = 0;
+    if (T->done)
+        return 0;
+    const float h = S->step;
+    const uint n_tf = F->light_tf_size, flags = F->flags;
+    const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+    const float t0 = T->base + (float)T->k * h, t1 = t0 + h;
+
+    DeepPoints pts[DEEP_MAX_SUB];
+    light_t v_front[DEEP_MAX_SUB]; /* each sub-ray's visibility at the segment's front end */
+    light_t v_start = (light_t)(0.0f), v_end = (light_t)(0.0f);
+    int any_points = 0, all_empty = 1;
+    for (int i = 0; i < T->nsub; ++i) {
+        DeepSub *s = &T->sub[i];
+        DeepPoints *p = &pts[i];
+        p->n = 0;
+        v_front[i] = s->v;
+        v_start += s->w * s->v;
+        float a = fmax(t0, s->ta), b = fmin(t1, s->tb);
+        if (!(b > a)) {
+            s->has_prev = 0;
+            v_end += s->w * s->v;
+            continue;
+        }
+        const float3 pa = s->o + a * s->d, pb = s->o + b * s->d;
+        if (skip && !light_bricks[brick_index(g, pa)] && !light_bricks[brick_index(g, pb)]) {
+            /* Both ends in bricks the light transfer function leaves empty: transparent. */
+            s->has_prev = 0;
+            v_end += s->w * s->v;
+            continue;
+        }
+        all_empty = 0;
+        const int full = a <= t0 && b >= t1;
+        if (full && use_lut) {
+            float sf = s->has_prev ? s->s_prev : sample_volume(vol, g, pa);
+            float sb = sample_volume(vol, g, pb);
+            s->s_prev = sb;
+            s->has_prev = 1;
+            size_t pair = (size_t)deep_quant(sf) * DEEP_LUT_RES + (size_t)deep_quant(sb);
+            __global const deep_node *entry = lut + pair * DEEP_LUT_NODES;
+            for (int j = 0; j < DEEP_LUT_NODES; ++j) {
+                deep_node nd = entry[j];
+                if (j < DEEP_LUT_NODES - 1 && DEEP_DEPTH(nd) >= 1.0f)
+                    continue; /* an unused interior slot */
+                p->x[p->n] = DEEP_DEPTH(nd);
+                p->v[p->n] = s->v * DEEP_VIS(nd);
+                p->n++;
+            }
+        } else {
+            s->has_prev = 0;
+            float3 mid = s->o + 0.5f * (a + b) * s->d;
+            float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, mid));
+            if (!full)
+                c = alpha_for_fraction(c, (b - a) / h);
+            float xa = (a - t0) / h, xb = (b - t0) / h;
+            if (xa > 0.0f) {
+                p->x[p->n] = xa;
+                p->v[p->n] = s->v;
+                p->n++;
+            }
+            p->x[p->n] = fmin(xb, 1.0f);
+            p->v[p->n] = s->v * light_pass(c, flags);
+            p->n++;
+        }
+        any_points = 1;
+        s->v = p->v[p->n - 1];
+        v_end += s->w * s->v;
+    }
+
+    if (any_points) {
+        /* The union of the sub-rays' positions, sorted, without repeats. */
+        float xs[DEEP_MAX_POINTS];
+        int nx = 0;
+        for (int i = 0; i < T->nsub; ++i)
+            for (int j = 0; j < pts[i].n; ++j) {
+                float x = pts[i].x[j];
+                int q = nx;
+                while (q > 0 && xs[q - 1] > x) {
+                    xs[q] = xs[q - 1];
+                    --q;
+                }
+                xs[q] = x;
+                ++nx;
+            }
+        /* A segment that follows empty ones starts with a point at its front end, so the fit
+         * sees the flat stretch before it as flat. */
+        float z_front = (float)T->k * T->zstep;
+        if (z_front > T->z_pushed) {
+            deep_fit_push(&T->fit, z_front, v_start, T->eps, e, &ne);
+            T->z_pushed = z_front;
+        }
+        float last = -1.0f;
+        for (int q = 0; q < nx; ++q) {
+            float x = xs[q];
+            if (!(x > last + 1e-6f) || !(x > 0.0f))
+                continue;
+            last = x;
+            light_t v = (light_t)(0.0f);
+            for (int i = 0; i < T->nsub; ++i)
+                v += T->sub[i].w * deep_points_eval(&pts[i], v_front[i], x);
+            float z = ((float)T->k + x) * T->zstep;
+            deep_fit_push(&T->fit, z, v, T->eps, e, &ne);
+            T->z_pushed = z;
+        }
+    }
+
+    /* Next segment, or a jump over bricks that are empty for every sub-ray. */
+    int k_next = T->k + 1;
+    if (skip && all_empty) {
+        float jump = (float)T->k_end;
+        for (int i = 0; i < T->nsub; ++i) {
+            const DeepSub *s = &T->sub[i];
+            if (!(s->tb > s->ta) || s->tb <= t1)
+                continue;
+            float tj;
+            if (s->ta > t1)
+                tj = s->ta; /* not entered yet: its entry */
+            else
+                tj = fmin(brick_exit(g, s->o, s->d, t1), s->tb);
+            jump = fmin(jump, floor((tj - T->base) / h));
+        }
+        if (jump > (float)k_next)
+            k_next = (int)jump;
+    }
+    T->k = k_next;
+    if (T->k >= T->k_end || light_max(v_end) < T->v_stop) {
+        deep_fit_finish(&T->fit, e, &ne);
+        T->done = 1;
+    }
+    return ne;
+}
+
+/* ---- building the map ------------------------------------------------------------------------
+ * deep_build: one work-group per tile of deep_tile x deep_tile texels (local size = tile). The
+ * tile's texels march in passes, as the paper's multi-pass fragment programs do: before each pass
+ * every texel marches until it has a node to write or its ray ends, and the work-group checks
+ * (local flag, barrier) whether any of its texels has a node;
+ * if so, one work-item takes the next block from the pool (atomic_inc on counter[0]) and links it
+ * into the tile's chain (head[tile], then next[block]; -1 ends a chain), and every texel writes
+ * up to block_size nodes into its own lane of the block's layers. A tile whose rays have all
+ * finished stops taking blocks. A block index at or beyond capacity is counted but not written:
+ * the host reads the counter back, grows the pool to what was asked for and builds again, so no
+ * node is ever dropped silently. Every work-item reaches every barrier (texels outside the map
+ * take part with nothing to march). */
+__kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
+                         __global const float4 *view_tf, __global const float4 *light_tf,
+                         __global const uchar *view_bricks, __global const uchar *light_bricks,
+                         __global const UmbraShadow *S, __global const deep_node *lut,
+                         uint use_lut, uint prefilter, float eps, __global deep_node *nodes,
+                         __global int *head, __global int *next, __global uint *counts,
+                         volatile __global uint *counter, uint capacity)
+{
+    (void)view_tf;
+    (void)view_bricks;
+    const int T = (int)S->deep_tile;
+    const int lane = (int)get_local_id(1) * T + (int)get_local_id(0);
+    const int tile = (int)get_group_id(1) * (int)S->tiles_per_row + (int)get_group_id(0);
+    const int n = (int)S->map_size;
+    const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
+    const uint K = S->block_size;
+    const size_t T2 = (size_t)(T * T);
+    const VolGeom g = vol_geom(F);
+    __local int l_block;
+    __local int l_more;
+
+    DeepTexel st;
+    st.done = 1;
+    if (gx < n && gy < n)
+        deep_texel_init(&st, S, g, (int2)(gx, gy), prefilter, eps);
+    deep_node pend[DEEP_MAX_EMIT];
+    int npend = 0, ppos = 0;
+    uint written = 0, layer_end = 0;
+    int prev_block = -1;
+    if (lane == 0)
+        head[tile] = -1;
+    for (;;) {
+        /* March until a node is ready or the ray is done: a ray that still runs may emit
+         * nothing more (transparent to its end), and must not make the tile take a block. */
+        while (ppos == npend && !st.done) {
+            npend = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, pend);
+            ppos = 0;
+        }
+        if (lane == 0)
+            l_more = 0;
+        barrier(CLK_LOCAL_MEM_FENCE);
+        if (ppos < npend)
+            l_more = 1;
+        barrier(CLK_LOCAL_MEM_FENCE);
+        if (!l_more)
+            break; /* the same value for the whole work-group */
+        if (lane == 0) {
+            uint b = atomic_inc(counter);
+            l_block = (int)b;
+            if (b < capacity) {
+                if (prev_block < 0)
+                    head[tile] = (int)b;
+                else if ((uint)prev_block < capacity)
+                    next[prev_block] = (int)b;
+                next[b] = -1;
+            }
+            prev_block = (int)b;
+        }
+        barrier(CLK_LOCAL_MEM_FENCE);
+        const int block = l_block;
+        layer_end += K;
+        while (written < layer_end) {
+            if (ppos == npend) {
+                if (st.done)
+                    break;
+                npend = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, pend);
+                ppos = 0;
+                continue;
+            }
+            if ((uint)block < capacity)
+                nodes[((size_t)block * K + (written + K - layer_end)) * T2 + (size_t)lane] =
+                    pend[ppos];
+            ++ppos;
+            ++written;
+        }
+    }
+    if (gx < n && gy < n)
+        counts[gy * n + gx] = written;
+}
+
+/* Fixed budget: keeps at most N = max_nodes nodes per texel. The march and the greedy fit run as
+ * above (with epsilon); while more than N nodes arrive, the interior node whose removal changes
+ * the function least (the largest channel distance between the node and the line joining its
+ * neighbours) is merged away, so the first node (where the visibility starts to drop) and the
+ * newest stay. Unused slots repeat the last node; a texel without attenuation stores (0, 1). */
+inline void deep_fixed_add(__global deep_node *o, int N, int *cnt, deep_node e)
+{
+    if (*cnt < N) {
+        o[(*cnt)++] = e;
+        return;
+    }
+    int best = 1;
+    float best_cost = UMBRA_INF;
+    for (int i = 1; i < N; ++i) {
+        deep_node a = o[i - 1], b = o[i], c = i + 1 < N ? o[i + 1] : e;
+        float span = DEEP_DEPTH(c) - DEEP_DEPTH(a);
+        float w = span > 0.0f ? (DEEP_DEPTH(b) - DEEP_DEPTH(a)) / span : 0.0f;
+        float cost = deep_max_abs(DEEP_VIS(b) - mix(DEEP_VIS(a), DEEP_VIS(c), w));
+        if (cost < best_cost) {
+            best_cost = cost;
+            best = i;
+        }
+    }
+    for (int i = best; i < N - 1; ++i)
+        o[i] = o[i + 1];
+    o[N - 1] = e;
+}
+
+__kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
+                               __global const float4 *view_tf, __global const float4 *light_tf,
+                               __global const uchar *view_bricks,
+                               __global const uchar *light_bricks, __global const UmbraShadow *S,
+                               __global const deep_node *lut, uint use_lut, uint prefilter,
+                               float eps, __global deep_node *out)
+{
+    (void)view_tf;
+    (void)view_bricks;
+    const int n = (int)S->map_size;
+    const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
+    if (gx >= n || gy >= n)
+        return;
+    const int N = (int)S->max_nodes;
+    const VolGeom g = vol_geom(F);
+    __global deep_node *o = out + (size_t)(gy * n + gx) * (size_t)N;
+    DeepTexel st;
+    deep_texel_init(&st, S, g, (int2)(gx, gy), prefilter, eps);
+    deep_node e[DEEP_MAX_EMIT];
+    int cnt = 0;
+    while (!st.done) {
+        int ne = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, e);
+        for (int q = 0; q < ne; ++q)
+            deep_fixed_add(o, N, &cnt, e[q]);
+    }
+    deep_node fill = cnt > 0 ? o[cnt - 1] : DEEP_NODE(0.0f, (light_t)(1.0f));
+    for (int q = cnt; q < N; ++q)
+        o[q] = fill;
+}
+
+#endif /* DEEP_BUILD_KERNELS */
+
+/* ---- lookup ----------------------------------------------------------------------------------
+ * The paper's lookup: the sample's nearest texel (no bilinear filtering of four visibilities, as
+ * in the paper: pre-filtering at build time does the anti-aliasing), its node list found through
+ * the layout (head / next / counts), searched linearly for the sample's depth and interpolated
+ * linearly. The search starts at the node the previous sample of the same view ray ended at
+ * (ShadowRay), in the same texel or, since neighbouring texels have similar node depths, in a new
+ * one; when that node lies deeper than the sample (the view ray moved toward the light) the search
+ * restarts at the texel's first node. */
+#define SHADOW_KERNEL_PARAMS                                                                   \
+    , __global const deep_node *deep_nodes, __global const int *deep_head,                    \
+        __global const int *deep_next, __global const uint *deep_counts
+
+typedef struct ShadowRay {
+    int texel; /* map texel of the last lookup, -1 before the first */
+    int n;     /* index of the node the last lookup interpolated from */
+    int block; /* the block holding node n (blocked layout) */
+} ShadowRay;
+
+inline void shadow_ray_init(ShadowRay *sr)
+{
+    sr->texel = -1;
+    sr->n = 0;
+    sr->block = -1;
+}
+
+inline deep_node deep_fetch(__global const deep_node *nodes, int fixed, size_t texel_base,
+                            int block, int j, uint K, size_t T2, int lane)
+{
+    if (fixed)
+        return nodes[texel_base + (size_t)j];
+    return nodes[((size_t)block * K + (size_t)((uint)j % K)) * T2 + (size_t)lane];
+}
+
+inline float3 deep_shadow(__global const UmbraShadow *S, __global const deep_node *nodes,
+                          __global const int *head, __global const int *next,
+                          __global const uint *counts, ShadowRay *sr, float3 p)
+{
+    float3 m = ls_world_to_map(S, p);
+    int2 t;
+    if (!isfinite(m.z) || !ls_base_texel(S, m.xy, &t))
+        return (float3)(1.0f);
+    const int idx = ls_texel_index(S, t);
+    if (idx < 0)
+        return (float3)(1.0f);
+    const int n = (int)S->map_size;
+    const int fixed = S->max_nodes > 0u;
+    const uint K = S->block_size;
+    const int T = (int)S->deep_tile;
+    const size_t T2 = (size_t)(T * T);
+    const int tx = idx % n, ty = idx / n;
+    const int tile = (ty / T) * (int)S->tiles_per_row + tx / T;
+    const int lane = (ty % T) * T + tx % T;
+    const size_t base = (size_t)idx * S->max_nodes;
+    const int count = fixed ? (int)S->max_nodes : (int)counts[idx];
+    const float d = m.z;
+    if (count <= 0)
+        return (float3)(1.0f);
+    if (sr->texel != idx) {
+        sr->texel = idx;
+        sr->n = min(sr->n, count - 1);
+        if (!fixed) {
+            int b = head[tile];
+            for (int q = sr->n / (int)K; q > 0; --q)
+                b = next[b];
+            sr->block = b;
+        }
+    }
+    deep_node a = deep_fetch(nodes, fixed, base, sr->block, sr->n, K, T2, lane);
+    if (d < DEEP_DEPTH(a) && sr->n > 0) {
+        sr->n = 0;
+        sr->block = fixed ? 0 : head[tile];
+        a = deep_fetch(nodes, fixed, base, sr->block, 0, K, T2, lane);
+    }
+    if (d <= DEEP_DEPTH(a))
+        return sr->n == 0 ? (float3)(1.0f) : light_rgb(DEEP_VIS(a));
+    for (;;) {
+        const int j = sr->n + 1;
+        if (j >= count)
+            return light_rgb(DEEP_VIS(a));
+        int b = sr->block;
+        if (!fixed && (uint)j % K == 0u)
+            b = next[b];
+        deep_node c = deep_fetch(nodes, fixed, base, b, j, K, T2, lane);
+        if (DEEP_DEPTH(c) >= d) {
+            float span = DEEP_DEPTH(c) - DEEP_DEPTH(a);
+            float w = span > 0.0f ? clamp((d - DEEP_DEPTH(a)) / span, 0.0f, 1.0f) : 1.0f;
+            return light_rgb(mix(DEEP_VIS(a), DEEP_VIS(c), w));
+        }
+        a = c;
+        sr->n = j;
+        sr->block = b;
+    }
+}
+
+#define SHADOW_FACTOR(sr, p)                                                                   \
+    deep_shadow(S, deep_nodes, deep_head, deep_next, deep_counts, &(sr), (p))
