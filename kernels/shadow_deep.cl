@@ -333,6 +333,8 @@ inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom
             tb_max = fmax(tb_max, s->tb);
         }
     }
+    /* Ray parameter base + (k + x) h lies at ls_depth (k + x) * zstep on every sub-ray: the
+     * orthographic rays share their start plane, the perspective / octahedral ones the light. */
     T->zstep = h * S->near_far[2];
     T->eps = eps;
     T->v_stop = fmax(0.5f * eps, 1e-4f);
