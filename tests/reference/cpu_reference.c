@@ -75,6 +75,8 @@ static void lookup(const float *tf, int n, float v, float out[4])
 static float *corrected(const float *tf, int n, float step_voxels)
 {
     float *t = malloc((size_t)n * 4 * sizeof *t);
+    if (!t)
+        return NULL;
     for (int i = 0; i < n; ++i) {
         memcpy(t + 4 * i, tf + 4 * i, 3 * sizeof *t);
         t[4 * i + 3] = 1.0f - powf(1.0f - tf[4 * i + 3], step_voxels);
@@ -88,6 +90,8 @@ static unsigned char *bricks(const prep *P, const float *tf, int n)
     const cpu_scene *s = P->s;
     const int B = P->B;
     unsigned char *out = calloc((size_t)P->nb[0] * P->nb[1] * P->nb[2], 1);
+    if (!out)
+        return NULL;
     for (int bz = 0; bz < P->nb[2]; ++bz)
         for (int by = 0; by < P->nb[1]; ++by)
             for (int bx = 0; bx < P->nb[0]; ++bx) {
@@ -145,24 +149,23 @@ static void prep_free(prep *P)
     free(P->light_bricks);
 }
 
-static int ray_box(const prep *P, v3 o, v3 d, float *t0, float *t1)
+/* The interval [*t0, *t1] of o + t d inside the box; *t1 < *t0 when the ray misses. */
+static void ray_box(const prep *P, v3 o, v3 d, float *t0, float *t1)
 {
     float lo = -INFINITY, hi = INFINITY;
     float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
     float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, bmax[3] = {P->bmax.x, P->bmax.y, P->bmax.z};
+    /* Multiplying by the reciprocal, as the kernel does, so both round alike: a one-ulp
+     * difference in the entry point can change the number of samples on a ray. A zero
+     * component gives +-inf (or NaN on a slab plane, which fminf/fmaxf drop). */
     for (int a = 0; a < 3; ++a) {
-        if (dd[a] == 0.0f) {
-            if (oo[a] < bmin[a] || oo[a] > bmax[a])
-                return 0;
-            continue;
-        }
-        float ta = (bmin[a] - oo[a]) / dd[a], tb = (bmax[a] - oo[a]) / dd[a];
+        float inv = 1.0f / dd[a];
+        float ta = (bmin[a] - oo[a]) * inv, tb = (bmax[a] - oo[a]) * inv;
         lo = fmaxf(lo, fminf(ta, tb));
         hi = fminf(hi, fmaxf(ta, tb));
     }
     *t0 = lo;
     *t1 = hi;
-    return 1;
 }
 
 static int brick_of(const prep *P, v3 p, int b[3])
@@ -224,8 +227,7 @@ static v3 shadow(const prep *P, v3 p)
     float dist;
     v3 d = to_light(P, p, &dist);
     float ta, tb;
-    if (!ray_box(P, p, d, &ta, &tb))
-        return mk(1, 1, 1);
+    ray_box(P, p, d, &ta, &tb);
     float t_start = fmaxf(ta, 0.0f), t_end = fminf(tb, dist);
     if (!(t_end > t_start))
         return mk(1, 1, 1);
@@ -339,7 +341,8 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
     float col[3] = {0, 0, 0}, A = 0.0f, c[4];
     uint32_t taken = 0;
     float ta, tb;
-    if (ray_box(P, org, d, &ta, &tb)) {
+    ray_box(P, org, d, &ta, &tb);
+    {
         float t0 = fmaxf(ta, 0.0f), t1 = fminf(tb, t_ground);
         if (t1 > t0) {
             const float hstep = P->step;
@@ -401,17 +404,50 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
     return taken;
 }
 
-uint64_t cpu_render(const cpu_scene *s, uint32_t w, uint32_t h, float *rgba)
-{
+struct cpu_prepared {
     prep P;
-    prep_init(&P, s);
-    view V = make_view(s, w, h);
+};
+
+cpu_prepared *cpu_prepare(const cpu_scene *s)
+{
+    cpu_prepared *p = malloc(sizeof *p);
+    if (!p)
+        return NULL;
+    prep_init(&p->P, s);
+    if (!p->P.view_tf || !p->P.light_tf || !p->P.view_bricks || !p->P.light_bricks) {
+        cpu_prepared_free(p);
+        return NULL;
+    }
+    return p;
+}
+
+void cpu_prepared_free(cpu_prepared *p)
+{
+    if (!p)
+        return;
+    prep_free(&p->P);
+    free(p);
+}
+
+uint64_t cpu_render_prepared(const cpu_prepared *p, uint32_t w, uint32_t h, float *rgba)
+{
+    const prep *P = &p->P;
+    view V = make_view(P->s, w, h);
     uint64_t total = 0;
 #pragma omp parallel for schedule(dynamic, 4) reduction(+ : total)
     for (int py = 0; py < (int)h; ++py)
         for (int px = 0; px < (int)w; ++px)
-            total += pixel(&P, &V, w, h, px, py, rgba + 4 * ((size_t)py * w + px));
-    prep_free(&P);
+            total += pixel(P, &V, w, h, px, py, rgba + 4 * ((size_t)py * w + px));
+    return total;
+}
+
+uint64_t cpu_render(const cpu_scene *s, uint32_t w, uint32_t h, float *rgba)
+{
+    cpu_prepared *p = cpu_prepare(s);
+    if (!p)
+        return 0;
+    uint64_t total = cpu_render_prepared(p, w, h, rgba);
+    cpu_prepared_free(p);
     return total;
 }
 

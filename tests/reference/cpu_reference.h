@@ -26,8 +26,17 @@ typedef struct cpu_scene {
 } cpu_scene;
 
 /* Renders w x h premultiplied RGBA floats; returns the number of samples taken (samples skipped
- * in empty bricks are not counted, as on the device). Parallel over rows with OpenMP. */
+ * in empty bricks are not counted, as on the device), or 0 if out of memory. Parallel over rows
+ * with OpenMP. */
 uint64_t cpu_render(const cpu_scene *s, uint32_t w, uint32_t h, float *rgba);
+
+/* The per-scene part of cpu_render done once: step-corrected tables and brick visibility (an
+ * O(voxels) pass). s is borrowed and must stay unchanged while the result is used. NULL if out of
+ * memory. The bench times cpu_render_prepared alone, as umbra keeps these between frames too. */
+typedef struct cpu_prepared cpu_prepared;
+cpu_prepared *cpu_prepare(const cpu_scene *s);
+uint64_t cpu_render_prepared(const cpu_prepared *p, uint32_t w, uint32_t h, float *rgba);
+void cpu_prepared_free(cpu_prepared *p); /* NULL is a no-op */
 
 /* The shadow factor at world point p (the exact reference's transmittance). */
 void cpu_shadow(const cpu_scene *s, const float p[3], float rgb[3]);

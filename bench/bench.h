@@ -1,0 +1,93 @@
+/* bench/bench.h: what umbra-bench's subcommands share.
+ *
+ * umbra-bench is one executable with subcommands (`umbra-bench raycast ...`). Each subcommand
+ * lives in its own file, bench/<name>.c, as `int bench_<name>(int argc, char **argv)` (argv[0] is
+ * the subcommand's name; returns the process exit status), and has one row in the table in
+ * bench/main.c. The helpers here (bench/bench_util.c) give every subcommand the same timing
+ * (median of N runs after warm-up), the same CSV layout, the same test volume and the same
+ * description of the machine, so their results read alike. Timing belongs here, never in tests. */
+#ifndef UMBRA_BENCH_H
+#define UMBRA_BENCH_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "umbra/umbra.h"
+
+/* ---- subcommands ------------------------------------------------------------------------------ */
+
+typedef int (*bench_fn)(int argc, char **argv);
+
+typedef struct bench_command {
+    const char *name;  /* the subcommand, as typed */
+    bench_fn run;
+    const char *help;  /* one line for `umbra-bench --help` */
+} bench_command;
+
+int bench_raycast(int argc, char **argv); /* bench/raycast.c */
+
+/* ---- timing -------------------------------------------------------------------------------------- */
+
+/* Wall-clock milliseconds from a monotonic clock. */
+double bench_now_ms(void);
+
+typedef struct bench_timing {
+    double median, min, max; /* milliseconds */
+    int runs;
+} bench_timing;
+
+/* Median (mean of the middle two for an even count), min and max of n >= 1 timings. */
+bench_timing bench_timing_of(const double *ms, int n);
+
+/* ---- CSV ----------------------------------------------------------------------------------------- */
+
+/* The header every timing CSV starts with. */
+#define BENCH_CSV_HEADER "case,ms_median,samples_per_s,samples,ms_min,ms_max"
+
+/* One row: samples_per_s = samples / median; samples == 0 leaves both fields empty (a peer that
+ * does not report what it sampled). */
+void bench_csv_row(FILE *f, const char *name, bench_timing t, uint64_t samples);
+
+/* ---- the test volume ------------------------------------------------------------------------------ */
+
+typedef struct bench_volume {
+    umbra_volume volume;  /* on the benchmark's context */
+    float *voxels;        /* the normalised values umbra samples, x fastest (malloc'ed) */
+    uint32_t dims[3];
+    float spacing[3];
+    float value_min, value_max; /* the value range mapped to [0, 1] */
+    char path[1024];      /* an NRRD header holding the same data (for peers such as VTK) */
+    char description[1200];
+    char tmpdir[256];     /* scratch directory of a written procedural volume, or "" */
+} bench_volume;
+
+/* The bonsai CT: `path` if given, else $UMBRA_DATA_DIR/bonsai.nhdr or
+ * $UMBRA_DATA_DIR/volumes/bonsai.nhdr, else UMBRA_SOURCE_DIR/../shared/data/volumes/bonsai.nhdr;
+ * when none exists (or procedural is nonzero), a procedural 256^3 uint8 stand-in of similar
+ * structure (see bench_util.c), which is also written to a scratch NRRD so peers read the same
+ * data. Prints what it loaded to stderr. Returns 0 on success. */
+int bench_volume_load_bonsai(umbra_context ctx, const char *path, int procedural,
+                             bench_volume *out);
+void bench_volume_free(bench_volume *v);
+
+/* ---- the machine ------------------------------------------------------------------------------------ */
+
+/* "model name" of /proc/cpuinfo and the number of online CPUs, e.g. "Intel(R) Xeon(R) ... x 2". */
+void bench_cpu_model(char *buf, size_t size);
+
+/* The OpenCL device umbra runs on, with its compute units and sampler back end. */
+void bench_device_description(umbra_context ctx, char *buf, size_t size);
+
+/* ---- command-line helpers ---------------------------------------------------------------------------- */
+
+/* Strict parsers: the whole string must be a number in range; return 0 on success. */
+int bench_parse_int(const char *s, long lo, long hi, long *out);
+int bench_parse_float(const char *s, float lo, float hi, float *out);
+int bench_parse_size(const char *s, uint32_t *w, uint32_t *h); /* "WxH", each in [1, 16384] */
+
+/* A context on `device` (NULL: the default choice, $UMBRA_DEVICE honoured); prints the reason to
+ * stderr and returns NULL on failure. */
+umbra_context bench_context(const char *device);
+
+#endif

@@ -1,0 +1,41 @@
+/* bench/main.c: umbra-bench, the benchmark driver. `umbra-bench <subcommand> [options]` runs one
+ * benchmark; each subcommand lives in its own file (see bench/bench.h for how to add one) and is
+ * listed in the table below. Results go to stdout as CSV, commentary to stderr. */
+#include <stdio.h>
+#include <string.h>
+
+#include "bench.h"
+
+static const bench_command commands[] = {
+    {"raycast", bench_raycast,
+     "view-space ray casting of the bonsai, no shadows: umbra vs the native-C twin (and VTK)"},
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: umbra-bench <subcommand> [options]\n"
+               "       umbra-bench <subcommand> --help\n\nsubcommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
+        fprintf(f, "  %-12s %s\n", commands[i].name, commands[i].help);
+    fprintf(f, "\nEnvironment: UMBRA_DEVICE picks the OpenCL device, UMBRA_DATA_DIR where the "
+               "volumes are,\nOMP_NUM_THREADS the native-C threads.\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
+        strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
+        if (strcmp(argv[1], commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "umbra-bench: unknown subcommand '%s'\n\n", argv[1]);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,616 @@
+/* bench/raycast.c: `umbra-bench raycast`, the foundation's speed check.
+ *
+ * One view of the bonsai CT (or its procedural stand-in, bench_util.c) at 512x512, view step 0.5
+ * voxel, no shadows (technique none), no gradient shading, no jitter, early ray termination at
+ * 0.99 and empty-space skipping on, rendered by
+ *   umbra     umbra_renderer_render on the OpenCL device (PoCL's CPU device here): device time of
+ *             the kernel (stats.render_ms) and, as umbra_wall, the wall time of the whole call
+ *             including the read-back of the image;
+ *   native_c  cpu_render_prepared from tests/reference/cpu_reference.c, the plain-C twin of the
+ *             same algorithm, compiled -O3 -march=native with OpenMP over image rows: what
+ *             hand-written C reaches on this CPU. Its per-scene preparation (step-corrected tables,
+ *             brick visibility) is done once outside the timing, as umbra keeps those between
+ *             frames too;
+ *   vtk_fixedpoint  VTK's CPU ray caster, vtkFixedPointVolumeRayCastMapper, on the same volume,
+ *             view, transfer function and sample distance (bench/vtk_raycast.py, run as a second
+ *             process under xvfb-run when there is no display), when a python3 that imports vtk
+ *             is found ($UMBRA_PYTHON, python3, /usr/bin/python3): wall time of
+ *             vtkRenderWindow::Render of an off-screen window.
+ * After the warm-up frames the three take turns frame by frame, so that other processes' load,
+ * which on a shared machine changes from second to second, touches all three alike. umbra and
+ * native_c take the same samples (the same positions; samples in skipped bricks are not
+ * counted) up to float rounding, which gives a handful of rays one sample more or less and those
+ * pixels a difference of a few 1e-3; both numbers are checked and reported. Medians, minima and maxima are over the timed frames.
+ *
+ * The view (also in bench/README.md): a perspective camera with 30 degrees vertical field of
+ * view, looking at the volume's centre from 1.5 box diagonals away along (0.35, 0.25, 1), y up
+ * (the bonsai stands along +y). The transfer function: bonsai_tf below, the same control points
+ * as bench/scenes/bonsai.tf (foliage translucent green, trunk brown, pot opaque), 256 entries,
+ * alpha per voxel step. Ambient 0 and a white light make each sample's colour its table colour. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bench.h"
+#include "cpu_reference.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#ifndef UMBRA_SOURCE_DIR
+#define UMBRA_SOURCE_DIR "."
+#endif
+
+static const umbra_tf_point bonsai_tf[] = {
+    {0.00f, {0.00f, 0.00f, 0.00f, 0.00f}},
+    {0.18f, {0.25f, 0.60f, 0.15f, 0.00f}},
+    {0.22f, {0.25f, 0.60f, 0.15f, 0.06f}}, /* foliage */
+    {0.38f, {0.30f, 0.55f, 0.15f, 0.06f}},
+    {0.42f, {0.55f, 0.35f, 0.15f, 0.00f}},
+    {0.46f, {0.55f, 0.35f, 0.15f, 0.25f}}, /* trunk */
+    {0.68f, {0.55f, 0.35f, 0.15f, 0.25f}},
+    {0.72f, {0.80f, 0.45f, 0.30f, 0.50f}}, /* pot */
+    {1.00f, {0.80f, 0.45f, 0.30f, 0.50f}},
+};
+enum { TF_RESOLUTION = 256 };
+
+static const float view_dir[3] = {0.35f, 0.25f, 1.0f};
+static const float view_distance = 1.5f; /* box diagonals */
+static const float view_fovy = 30.0f;
+
+typedef struct options {
+    int runs, warmup;
+    uint32_t width, height;
+    float step;
+    const char *volume;
+    int procedural;
+    int vtk;
+    const char *results;
+    const char *device;
+    const char *save;
+} options;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: umbra-bench raycast [options]\n"
+            "  --runs N         timed runs per case (default 7), after\n"
+            "  --warmup N       untimed warm-up runs (default 2)\n"
+            "  --size WxH       image size (default 512x512)\n"
+            "  --step S         view step in voxels (default 0.5)\n"
+            "  --volume FILE    volume instead of the bonsai (.nrrd/.nhdr/.dat)\n"
+            "  --procedural     use the procedural 256^3 stand-in even if the bonsai is present\n"
+            "  --no-vtk         skip the VTK row\n"
+            "  --device SPEC    OpenCL device (P:D or a name substring; default $UMBRA_DEVICE)\n"
+            "  --results DIR    also write DIR/raycast.csv and DIR/raycast.md\n"
+            "  --save PREFIX    write PREFIX_umbra.png, PREFIX_native_c.png (and _vtk.png)\n"
+            "Prints CSV (" BENCH_CSV_HEADER ") on stdout: rows umbra (device time),\n"
+            "umbra_wall, native_c and, when python3 imports vtk, vtk_fixedpoint (frames\n"
+            "interleaved with umbra's); the ratio of umbra's samples/s to native_c's and of\n"
+            "VTK's time per frame to umbra's on stderr.\n");
+}
+
+static int parse(int argc, char **argv, options *o)
+{
+    o->runs = 7;
+    o->warmup = 2;
+    o->width = o->height = 512;
+    o->step = 0.5f;
+    o->volume = NULL;
+    o->procedural = 0;
+    o->vtk = 1;
+    o->results = NULL;
+    o->device = NULL;
+    o->save = NULL;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        long n;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            exit(0);
+        } else if (strcmp(a, "--runs") == 0) {
+            if (bench_parse_int(v, 1, 1000, &n)) {
+                fprintf(stderr, "umbra-bench raycast: --runs '%s': need 1..1000\n", v ? v : "");
+                return -1;
+            }
+            o->runs = (int)n;
+            ++i;
+        } else if (strcmp(a, "--warmup") == 0) {
+            if (bench_parse_int(v, 0, 1000, &n)) {
+                fprintf(stderr, "umbra-bench raycast: --warmup '%s': need 0..1000\n", v ? v : "");
+                return -1;
+            }
+            o->warmup = (int)n;
+            ++i;
+        } else if (strcmp(a, "--size") == 0) {
+            if (bench_parse_size(v, &o->width, &o->height)) {
+                fprintf(stderr, "umbra-bench raycast: --size '%s': need WxH\n", v ? v : "");
+                return -1;
+            }
+            ++i;
+        } else if (strcmp(a, "--step") == 0) {
+            if (bench_parse_float(v, 0.01f, 64.0f, &o->step)) {
+                fprintf(stderr, "umbra-bench raycast: --step '%s': need 0.01..64\n", v ? v : "");
+                return -1;
+            }
+            ++i;
+        } else if (strcmp(a, "--volume") == 0 && v) {
+            o->volume = v;
+            ++i;
+        } else if (strcmp(a, "--device") == 0 && v) {
+            o->device = v;
+            ++i;
+        } else if (strcmp(a, "--results") == 0 && v) {
+            o->results = v;
+            ++i;
+        } else if (strcmp(a, "--save") == 0 && v) {
+            o->save = v;
+            ++i;
+        } else if (strcmp(a, "--procedural") == 0) {
+            o->procedural = 1;
+        } else if (strcmp(a, "--no-vtk") == 0) {
+            o->vtk = 0;
+        } else {
+            fprintf(stderr, "umbra-bench raycast: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static umbra_camera bench_camera(const bench_volume *v)
+{
+    float diag = 0.0f, len = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        float e = (float)v->dims[a] * v->spacing[a];
+        diag += e * e;
+        len += view_dir[a] * view_dir[a];
+    }
+    diag = sqrtf(diag);
+    len = sqrtf(len);
+    umbra_camera c;
+    memset(&c, 0, sizeof c);
+    c.projection = UMBRA_PERSPECTIVE;
+    for (int a = 0; a < 3; ++a)
+        c.eye[a] = view_dir[a] / len * view_distance * diag;
+    c.up[1] = 1.0f;
+    c.fovy_degrees = view_fovy;
+    c.ortho_height = diag;
+    return c;
+}
+
+/* ---- VTK -------------------------------------------------------------------------------------- */
+
+/* A python3 that imports VTK's volume rendering, or NULL. */
+static const char *find_vtk_python(void)
+{
+    static const char *const fixed[] = {"python3", "/usr/bin/python3"};
+    const char *env = getenv("UMBRA_PYTHON");
+    const char *cands[3];
+    int n = 0;
+    if (env && *env)
+        cands[n++] = env;
+    cands[n++] = fixed[0];
+    cands[n++] = fixed[1];
+    char cmd[1200];
+    for (int i = 0; i < n; ++i) {
+        snprintf(cmd, sizeof cmd,
+                 "'%s' -c 'import vtkmodules.vtkRenderingVolume, vtkmodules.vtkRenderingVolumeOpenGL2' >/dev/null 2>&1", cands[i]);
+        if (system(cmd) == 0)
+            return cands[i];
+    }
+    return NULL;
+}
+
+/* bench/vtk_raycast.py --serve, running beside umbra-bench: a frame per request. */
+typedef struct vtk_peer {
+    pid_t pid;
+    FILE *to, *from;
+} vtk_peer;
+
+/* Starts the script on the benchmark's view; 0 once it has set up and warmed up. */
+static int vtk_start(const options *o, const bench_volume *v, const umbra_camera *cam,
+                     float step_world, vtk_peer *peer, char *why, size_t why_size)
+{
+    memset(peer, 0, sizeof *peer);
+    peer->pid = -1;
+    const char *py = find_vtk_python();
+    if (!py) {
+        snprintf(why, why_size, "no python3 imports vtk (Debian: apt-get install python3-vtk9)");
+        return -1;
+    }
+    if (!v->path[0]) {
+        snprintf(why, why_size, "the volume has no file VTK could read");
+        return -1;
+    }
+    /* VTK's render window needs an X display; Xvfb provides one on a headless machine. */
+    const char *display = getenv("DISPLAY");
+    int xvfb = !(display && *display) && system("command -v xvfb-run >/dev/null 2>&1") == 0;
+    char tf[1024] = "";
+    size_t len = 0;
+    for (size_t i = 0; i < sizeof bonsai_tf / sizeof bonsai_tf[0] && len < sizeof tf; ++i)
+        len += (size_t)snprintf(tf + len, sizeof tf - len, "%s%g,%g,%g,%g,%g", i ? ";" : "",
+                                bonsai_tf[i].value, bonsai_tf[i].rgba[0], bonsai_tf[i].rgba[1],
+                                bonsai_tf[i].rgba[2], bonsai_tf[i].rgba[3]);
+    char save[600] = "";
+    if (o->save)
+        snprintf(save, sizeof save, " --save '%s_vtk.png'", o->save);
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "exec %s'%s' '%s/bench/vtk_raycast.py' --serve --nrrd '%s' --size %u %u "
+             "--eye %.9g %.9g %.9g --target %.9g %.9g %.9g --up %.9g %.9g %.9g --fovy %.9g "
+             "--step %.9g --range %.9g %.9g --tf '%s' --warmup %d%s",
+             xvfb ? "xvfb-run -a " : "", py, UMBRA_SOURCE_DIR, v->path, o->width, o->height,
+             cam->eye[0], cam->eye[1], cam->eye[2], cam->target[0], cam->target[1],
+             cam->target[2], cam->up[0], cam->up[1], cam->up[2], cam->fovy_degrees, step_world,
+             v->value_min, v->value_max, tf, o->warmup, save);
+    int in[2], out[2];
+    if (pipe(in) != 0)
+        goto broken;
+    if (pipe(out) != 0) {
+        close(in[0]);
+        close(in[1]);
+        goto broken;
+    }
+    fflush(NULL);
+    peer->pid = fork();
+    if (peer->pid == 0) {
+        dup2(in[0], STDIN_FILENO);
+        dup2(out[1], STDOUT_FILENO);
+        close(in[0]);
+        close(in[1]);
+        close(out[0]);
+        close(out[1]);
+        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
+        _exit(127);
+    }
+    close(in[0]);
+    close(out[1]);
+    if (peer->pid < 0) {
+        close(in[1]);
+        close(out[0]);
+        goto broken;
+    }
+    peer->to = fdopen(in[1], "w");
+    peer->from = fdopen(out[0], "r");
+    if (!peer->to || !peer->from)
+        goto broken;
+    char line[256];
+    while (fgets(line, sizeof line, peer->from))
+        if (strncmp(line, "ready", 5) == 0)
+            return 0;
+broken:
+    snprintf(why, why_size, "bench/vtk_raycast.py did not start (run it by hand to see why)");
+    return -1;
+}
+
+/* One frame; its wall time in ms, or a negative value if the peer failed. */
+static double vtk_frame(vtk_peer *peer)
+{
+    char line[256];
+    double ms;
+    if (fputs("frame\n", peer->to) == EOF || fflush(peer->to) != 0)
+        return -1.0;
+    while (fgets(line, sizeof line, peer->from))
+        if (sscanf(line, "ms %lf", &ms) == 1)
+            return ms;
+    return -1.0;
+}
+
+/* Ends the peer; 0 if it exited cleanly. */
+static int vtk_stop(vtk_peer *peer)
+{
+    int status = -1;
+    if (peer->to) {
+        fputs("quit\n", peer->to);
+        fclose(peer->to);
+    }
+    if (peer->from) {
+        char line[256];
+        while (fgets(line, sizeof line, peer->from))
+            ; /* drain until the script exits */
+        fclose(peer->from);
+    }
+    if (peer->pid > 0 && waitpid(peer->pid, &status, 0) != peer->pid)
+        status = -1;
+    memset(peer, 0, sizeof *peer);
+    return status == 0 ? 0 : -1;
+}
+
+/* ---- the report ------------------------------------------------------------------------------------ */
+
+typedef struct row {
+    const char *name;
+    bench_timing t;
+    uint64_t samples;
+} row;
+
+static void write_results(const options *o, int argc, char **argv, const bench_volume *v,
+                          const char *device, const row *rows, int nrows, double ratio,
+                          double vtk_ratio, double image_diff, const char *samples_equal)
+{
+    char path[1100], cpu[600], date[64];
+    time_t now = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
+    bench_cpu_model(cpu, sizeof cpu);
+    mkdir(o->results, 0777); /* may exist already; fopen below reports real trouble */
+    snprintf(path, sizeof path, "%s/raycast.csv", o->results);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "umbra-bench raycast: cannot write %s\n", path);
+        return;
+    }
+    fprintf(f, "%s\n", BENCH_CSV_HEADER);
+    for (int i = 0; i < nrows; ++i)
+        bench_csv_row(f, rows[i].name, rows[i].t, rows[i].samples);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/raycast.md", o->results);
+    f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "umbra-bench raycast: cannot write %s\n", path);
+        return;
+    }
+    fprintf(f, "# umbra-bench raycast\n\n");
+    fprintf(f, "- date: %s\n- command: `", date);
+    for (int i = 0; i < argc; ++i)
+        fprintf(f, "%s%s", i ? " " : "umbra-bench ", argv[i]);
+    fprintf(f, "`\n- OpenCL device: %s\n- CPU: %s\n", device, cpu);
+#ifdef _OPENMP
+    fprintf(f, "- native C: OpenMP, %d threads\n", omp_get_max_threads());
+#else
+    fprintf(f, "- native C: built without OpenMP (1 thread)\n");
+#endif
+    fprintf(f, "- volume: %s (%u x %u x %u)\n", v->description, v->dims[0], v->dims[1],
+            v->dims[2]);
+    fprintf(f, "- view: %ux%u, step %g voxel, no shadows, no shading, early termination 0.99, "
+               "empty-space skipping (camera and transfer function: bench/README.md)\n",
+            o->width, o->height, o->step);
+    fprintf(f, "- medians of %d frames after %d warm-up frames; umbra, native C and VTK take "
+               "turns frame by frame\n\n", o->runs, o->warmup);
+    fprintf(f, "| case | ms median | samples/s | samples | ms min | ms max |\n"
+               "|---|---:|---:|---:|---:|---:|\n");
+    for (int i = 0; i < nrows; ++i) {
+        if (rows[i].samples)
+            fprintf(f, "| %s | %.1f | %.3g | %llu | %.1f | %.1f |\n", rows[i].name,
+                    rows[i].t.median, (double)rows[i].samples / (rows[i].t.median * 1e-3),
+                    (unsigned long long)rows[i].samples, rows[i].t.min, rows[i].t.max);
+        else
+            fprintf(f, "| %s | %.1f | | | %.1f | %.1f |\n", rows[i].name, rows[i].t.median,
+                    rows[i].t.min, rows[i].t.max);
+    }
+    fprintf(f, "\numbra / native C samples per second: **%.2f** (target >= 0.9).\n", ratio);
+    if (vtk_ratio > 0.0)
+        fprintf(f, "VTK / umbra time per frame: **%.2f** (target > 1: umbra faster).\n",
+                vtk_ratio);
+    fprintf(f, "umbra vs native C: samples %s; largest pixel difference %.2e.\n",
+            samples_equal, image_diff);
+    fclose(f);
+    fprintf(stderr, "wrote %s/raycast.csv and %s/raycast.md\n", o->results, o->results);
+}
+
+static void save_png(umbra_context ctx, const char *prefix, const char *name, uint32_t w,
+                     uint32_t h, const float *rgba)
+{
+    char path[600];
+    snprintf(path, sizeof path, "%s_%s.png", prefix, name);
+    if (umbra_image_write(ctx, path, w, h, rgba) != UMBRA_SUCCESS)
+        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
+}
+
+/* ---- the benchmark ------------------------------------------------------------------------------------ */
+
+/* Renders one umbra frame: device and wall milliseconds, samples. */
+static int umbra_frame(umbra_context ctx, umbra_renderer r, const options *o, float *rgba,
+                       double *dev_ms, double *wall_ms, uint64_t *samples)
+{
+    double t0 = bench_now_ms();
+    if (umbra_renderer_render(r, o->width, o->height, rgba) != UMBRA_SUCCESS) {
+        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
+        return -1;
+    }
+    *wall_ms = bench_now_ms() - t0;
+    umbra_render_stats st;
+    umbra_renderer_get_stats(r, &st);
+    *dev_ms = st.render_ms;
+    *samples = st.samples;
+    return 0;
+}
+
+int bench_raycast(int argc, char **argv)
+{
+    options o;
+    if (parse(argc, argv, &o) != 0)
+        return 2;
+    int status = 1;
+    umbra_context ctx = bench_context(o.device);
+    if (!ctx)
+        return 1;
+    bench_volume vol;
+    umbra_transfer_function tf = NULL;
+    umbra_renderer r = NULL;
+    cpu_prepared *prepared = NULL;
+    vtk_peer peer = {-1, NULL, NULL};
+    int vtk_running = 0;
+    size_t npix = (size_t)o.width * o.height;
+    float *img_umbra = malloc(npix * 4 * sizeof(float));
+    float *img_native = malloc(npix * 4 * sizeof(float));
+    double *t_dev = malloc((size_t)o.runs * sizeof(double));
+    double *t_wall = malloc((size_t)o.runs * sizeof(double));
+    double *t_native = malloc((size_t)o.runs * sizeof(double));
+    double *t_vtk = malloc((size_t)o.runs * sizeof(double));
+    char device[700];
+    bench_device_description(ctx, device, sizeof device);
+    if (bench_volume_load_bonsai(ctx, o.volume, o.procedural, &vol) != 0)
+        goto done;
+    if (!img_umbra || !img_native || !t_dev || !t_wall || !t_native || !t_vtk) {
+        fprintf(stderr, "umbra-bench raycast: out of memory\n");
+        goto done;
+    }
+    fprintf(stderr, "device: %s\n", device);
+
+    umbra_camera cam = bench_camera(&vol);
+    umbra_light light;
+    memset(&light, 0, sizeof light);
+    light.type = UMBRA_LIGHT_DIRECTIONAL;
+    light.direction[1] = -1.0f;
+    light.color[0] = light.color[1] = light.color[2] = 1.0f;
+    umbra_render_desc ro;
+    umbra_render_desc_init(&ro);
+    ro.step = o.step;
+    ro.ambient[0] = ro.ambient[1] = ro.ambient[2] = 0.0f;
+    umbra_shadow_desc sh;
+    umbra_shadow_desc_init(&sh);
+    sh.technique = UMBRA_SHADOW_NONE;
+    if (umbra_transfer_function_create_from_points(ctx, bonsai_tf,
+                                                   sizeof bonsai_tf / sizeof bonsai_tf[0],
+                                                   TF_RESOLUTION, &tf) != UMBRA_SUCCESS ||
+        umbra_renderer_create(ctx, &r) != UMBRA_SUCCESS ||
+        umbra_renderer_set_volume(r, vol.volume) != UMBRA_SUCCESS ||
+        umbra_renderer_set_transfer_function(r, tf) != UMBRA_SUCCESS ||
+        umbra_renderer_set_camera(r, &cam) != UMBRA_SUCCESS ||
+        umbra_renderer_set_light(r, &light) != UMBRA_SUCCESS ||
+        umbra_renderer_set_options(r, &ro) != UMBRA_SUCCESS ||
+        umbra_renderer_set_shadow(r, &sh) != UMBRA_SUCCESS) {
+        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
+        goto done;
+    }
+
+    /* native C, on the very same normalised voxels, table and view */
+    cpu_scene cs;
+    memset(&cs, 0, sizeof cs);
+    cs.voxels = vol.voxels;
+    for (int a = 0; a < 3; ++a) {
+        cs.dims[a] = (int)vol.dims[a];
+        cs.spacing[a] = vol.spacing[a];
+    }
+    cs.tf = umbra_transfer_function_data(tf);
+    cs.tf_count = (int)umbra_transfer_function_size(tf);
+    cs.camera = cam;
+    cs.light = light;
+    cs.opts = ro;
+    cs.shadow = UMBRA_SHADOW_NONE;
+    cs.reference_step = sh.reference_step;
+    umbra_volume_info info;
+    umbra_volume_get_info(vol.volume, &info);
+    cs.brick_size = (int)info.brick_size;
+    double tp = bench_now_ms();
+    prepared = cpu_prepare(&cs);
+    tp = bench_now_ms() - tp;
+    if (!prepared) {
+        fprintf(stderr, "umbra-bench raycast: out of memory in cpu_prepare\n");
+        goto done;
+    }
+
+    /* VTK in its own process, set up and warmed up before the timed frames. */
+    if (o.vtk) {
+        char why[256];
+        float voxel = fminf(vol.spacing[0], fminf(vol.spacing[1], vol.spacing[2]));
+        signal(SIGPIPE, SIG_IGN); /* a peer that dies shows as a failed write, not a signal */
+        if (vtk_start(&o, &vol, &cam, o.step * voxel, &peer, why, sizeof why) == 0)
+            vtk_running = 1;
+        else
+            fprintf(stderr, "vtk_fixedpoint: skipped: %s\n", why);
+        if (!vtk_running)
+            vtk_stop(&peer);
+    }
+
+    /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, so
+     * that a change in the machine's load (other processes) during the measurement touches all
+     * alike. */
+    uint64_t samples_umbra = 0, samples_native = 0;
+    double dev, wall;
+    for (int i = 0; i < o.warmup; ++i) {
+        if (umbra_frame(ctx, r, &o, img_umbra, &dev, &wall, &samples_umbra) != 0)
+            goto done;
+        samples_native = cpu_render_prepared(prepared, o.width, o.height, img_native);
+    }
+    for (int i = 0; i < o.runs; ++i) {
+        if (umbra_frame(ctx, r, &o, img_umbra, &t_dev[i], &t_wall[i], &samples_umbra) != 0)
+            goto done;
+        double t0 = bench_now_ms();
+        samples_native = cpu_render_prepared(prepared, o.width, o.height, img_native);
+        t_native[i] = bench_now_ms() - t0;
+        if (vtk_running && (t_vtk[i] = vtk_frame(&peer)) < 0.0) {
+            fprintf(stderr, "vtk_fixedpoint: dropped: bench/vtk_raycast.py stopped answering\n");
+            vtk_stop(&peer);
+            vtk_running = 0;
+        }
+    }
+    if (vtk_running && vtk_stop(&peer) != 0)
+        fprintf(stderr, "vtk_fixedpoint: bench/vtk_raycast.py exited with an error\n");
+
+    double diff = 0.0;
+    for (size_t i = 0; i < npix * 4; ++i) {
+        double d = fabs((double)img_umbra[i] - (double)img_native[i]);
+        diff = d > diff ? d : diff;
+    }
+    fprintf(stderr, "native C: preparation (tables, bricks; not timed) %.1f ms", tp);
+#ifdef _OPENMP
+    fprintf(stderr, ", %d OpenMP threads", omp_get_max_threads());
+#endif
+    /* Both take the same samples up to float rounding: a last-bit difference in a ray's
+     * direction (OpenCL's normalize() against the C twin's 1/sqrtf) can move a sample across a
+     * brick face or the ray's end, so a few rays in a million take one sample more or less. */
+    fprintf(stderr, "\numbra vs native C: samples %llu vs %llu (%+.1e relative), largest pixel "
+                    "difference %.2e\n",
+            (unsigned long long)samples_umbra, (unsigned long long)samples_native,
+            ((double)samples_umbra - (double)samples_native) / (double)samples_native, diff);
+
+    row rows[4];
+    int nrows = 0;
+    rows[nrows++] = (row){"umbra", bench_timing_of(t_dev, o.runs), samples_umbra};
+    rows[nrows++] = (row){"umbra_wall", bench_timing_of(t_wall, o.runs), samples_umbra};
+    rows[nrows++] = (row){"native_c", bench_timing_of(t_native, o.runs), samples_native};
+    double vtk_ratio = 0.0;
+    if (vtk_running) {
+        rows[nrows++] = (row){"vtk_fixedpoint", bench_timing_of(t_vtk, o.runs), 0};
+        vtk_ratio = rows[3].t.median / rows[0].t.median;
+    }
+    printf("%s\n", BENCH_CSV_HEADER);
+    for (int i = 0; i < nrows; ++i)
+        bench_csv_row(stdout, rows[i].name, rows[i].t, rows[i].samples);
+    fflush(stdout);
+    double sps_umbra = (double)samples_umbra / rows[0].t.median;
+    double sps_native = (double)samples_native / rows[2].t.median;
+    double ratio = sps_umbra / sps_native;
+    fprintf(stderr, "ratio umbra/native_c samples/s: %.3f (target >= 0.9)\n", ratio);
+    if (vtk_ratio > 0.0)
+        fprintf(stderr, "ratio vtk_fixedpoint/umbra ms per frame: %.3f (target > 1)\n", vtk_ratio);
+    if (o.save) {
+        save_png(ctx, o.save, "umbra", o.width, o.height, img_umbra);
+        save_png(ctx, o.save, "native_c", o.width, o.height, img_native);
+    }
+    if (o.results) {
+        char same[160];
+        if (samples_umbra == samples_native)
+            snprintf(same, sizeof same, "identical (%llu)", (unsigned long long)samples_umbra);
+        else
+            snprintf(same, sizeof same, "%llu vs %llu (float rounding at brick faces and ray ends)",
+                     (unsigned long long)samples_umbra, (unsigned long long)samples_native);
+        write_results(&o, argc, argv, &vol, device, rows, nrows, ratio, vtk_ratio, diff, same);
+    }
+    status = 0;
+done:
+    if (vtk_running)
+        vtk_stop(&peer);
+    cpu_prepared_free(prepared);
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    bench_volume_free(&vol);
+    umbra_context_release(ctx);
+    free(img_umbra);
+    free(img_native);
+    free(t_dev);
+    free(t_wall);
+    free(t_native);
+    free(t_vtk);
+    return status;
+}
