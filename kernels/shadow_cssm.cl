@@ -1,0 +1,120 @@
+/* kernels/shadow_cssm.cl: colored stochastic shadow maps for direct volume rendering (Weidner &
+ * Linsen, after McGuire & Enderton's CSSM for surfaces).
+ *
+ * Generation, the paper's Table 1 (cssm_build): one photon per texel, on the light ray through
+ * the texel centre, discretised into segments i. Per segment one random number r_i, shared by the
+ * channels, and per channel the probability that the photon is not transmitted,
+ * rho_i = alpha_i (1 - t_i) (1 - light_pass in the shading model: t is the light transfer
+ * function's RGB in coloured mode, 0 in grey mode). Where rho_i > r_i the channel's depth is set
+ * to min(c, z_i) (z grows along the ray, so that is the first such segment); the march stops once
+ * every channel is set. Unset channels keep LS_DEPTH_NEVER. With UMBRA_LIGHT_CHANNELS == 1 (a grey
+ * light) one channel is simulated and stored, not three.
+ *
+ * Segments are the reference's: whole steps of S->step plus one partial step, sampled at their
+ * midpoints with the step-corrected light table (the partial one re-corrected), so the product of
+ * the (1 - rho_i) along a whole ray is the reference's transmittance. z_i is the depth of segment
+ * i's midpoint, its sample point: a sample at depth s is then shadowed by exactly the segments
+ * whose sample lies in front of it, so P(lit) = prod over those of (1 - rho_i), within half a step
+ * of the continuous exp(-sigma d) on either side, and no bias is needed (the paper has none).
+ *
+ * r_i = umbra_random(seed, x, y, i) with i the segment's index along the ray: counter-based, so
+ * the map depends on the seed alone (same seed, same map and image, bit for bit), and skipped
+ * empty segments (rho = 0, never > r) change nothing.
+ *
+ * Lookup, the paper's Table 2: the m taps around the sample's texel (ls_taps); channel c is lit by
+ * each tap whose stored depth lies beyond the sample's (c_lambda > s_z); the factor is j/m. */
+
+#define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
+
+typedef struct ShadowRay {
+    int unused;
+} ShadowRay;
+
+inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
+
+#if UMBRA_LIGHT_CHANNELS == 1
+#define CSSM_STORE(v, i, map) ((map)[i] = (v))
+#define CSSM_LOAD(i, map) ((map)[i])
+#define CSSM_ALL_SET(c) ((c) < LS_DEPTH_NEVER)
+#define CSSM_HIT(rho, r) ((rho) > (r))
+#else
+#define CSSM_STORE(v, i, map) vstore3((v), (i), (map))
+#define CSSM_LOAD(i, map) vload3((i), (map))
+#define CSSM_ALL_SET(c) all((c) < (float3)(LS_DEPTH_NEVER))
+#define CSSM_HIT(rho, r) ((rho) > (float3)(r))
+#endif
+
+__kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
+                         __global const float4 *view_tf, __global const float4 *light_tf,
+                         __global const uchar *view_bricks, __global const uchar *light_bricks,
+                         __global const UmbraShadow *S, __global float *map)
+{
+    const int x = get_global_id(0), y = get_global_id(1);
+    const int n = (int)S->map_size;
+    if (x >= n || y >= n)
+        return;
+    (void)view_tf;
+    (void)view_bricks;
+    const VolGeom g = vol_geom(F);
+    float3 o, d;
+    const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
+    light_t c = (light_t)(LS_DEPTH_NEVER);
+    if (tb.y > tb.x) {
+        const float h = S->step;
+        const uint n_tf = F->light_tf_size, flags = F->flags, seed = S->seed;
+        const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+        const float len = tb.y - tb.x;
+        const int n_full = (int)floor(len / h);
+        const float last = len - (float)n_full * h;
+        float t_visible = -UMBRA_INF;
+        /* Segment k covers [tb.x + k h, tb.x + k h + seg]; k == n_full is the partial one. */
+        for (int k = 0; k <= n_full;) {
+            const float seg = k < n_full ? h : last;
+            if (!(seg > 0.0f))
+                break;
+            const float t_mid = tb.x + (float)k * h + 0.5f * seg;
+            const float3 q = o + t_mid * d;
+            /* The brick table is read once per brick crossed (t_visible), not per sample. */
+            if (skip && k < n_full && t_mid >= t_visible) {
+                const float t_exit = brick_exit(g, o, d, t_mid);
+                if (!light_bricks[brick_index(g, q)]) {
+                    k = next_sample_after(tb.x, h, 0.5f, t_exit, k);
+                    continue;
+                }
+                t_visible = t_exit;
+            }
+            float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
+            if (k == n_full)
+                col = alpha_for_fraction(col, seg / h);
+            const light_t rho = 1.0f - light_pass(col, flags);
+            const float r = umbra_random(seed, (uint)x, (uint)y, (uint)k);
+            c = select(c, fmin(c, (light_t)(ls_depth(S, o, t_mid))), CSSM_HIT(rho, r));
+            if (CSSM_ALL_SET(c))
+                break;
+            ++k;
+        }
+    }
+    CSSM_STORE(c, y * n + x, map);
+}
+
+/* Table 2: per channel, the fraction of the taps whose stored depth lies beyond p's. */
+inline float3 cssm_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
+{
+    const float3 m = ls_world_to_map(S, p);
+    int2 base;
+    if (!ls_base_texel(S, m.xy, &base))
+        return (float3)(1.0f);
+    const uint taps = S->taps;
+    const float s = m.z - S->depth_bias;
+    light_t lit = (light_t)(0.0f);
+    for (uint j = 0; j < taps; ++j) {
+        const int i = ls_texel_index(S, base + ls_taps[j]);
+        if (i < 0)
+            lit += 1.0f;
+        else
+            lit += select((light_t)(0.0f), (light_t)(1.0f), CSSM_LOAD(i, map) > (light_t)(s));
+    }
+    return light_rgb(lit / (float)taps);
+}
+
+#define SHADOW_FACTOR(sr, p) cssm_lookup(S, shadow_map, (p))

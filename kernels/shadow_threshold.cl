@@ -1,0 +1,101 @@
+/* kernels/shadow_threshold.cl: the opacity-threshold shadow map ("traditional shadow mapping,
+ * where a thresholding at opacity 0.5 is applied", as the CSSM paper compares against).
+ *
+ * threshold_build marches each texel's light ray (through the texel centre) and stores the
+ * normalised depth where the accumulated opacity first exceeds S->threshold, or LS_DEPTH_NEVER.
+ * Only the light transfer function's opacity counts: the map holds one depth, so it cannot carry
+ * colour and ignores the transmission colour. The lookup tests a sample against that depth:
+ * shadowed (0) beyond it, lit (1) before; with S->taps > 1 it averages the tests at the CSSM tap
+ * offsets (PCF), so that its softness compares fairly with CSSM's.
+ *
+ * The march is the reference's: whole steps of S->step plus one partial step, each sampled at its
+ * midpoint with the step-corrected light table, empty bricks skipped on the same grid. Within the
+ * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
+ * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
+ * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. */
+
+#define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
+
+typedef struct ShadowRay {
+    int unused;
+} ShadowRay;
+
+inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
+
+__kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
+                              __global const float4 *view_tf, __global const float4 *light_tf,
+                              __global const uchar *view_bricks,
+                              __global const uchar *light_bricks, __global const UmbraShadow *S,
+                              __global float *map)
+{
+    const int x = get_global_id(0), y = get_global_id(1);
+    const int n = (int)S->map_size;
+    if (x >= n || y >= n)
+        return;
+    (void)view_tf;
+    (void)view_bricks;
+    const VolGeom g = vol_geom(F);
+    float3 o, d;
+    const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
+    float depth = LS_DEPTH_NEVER;
+    if (tb.y > tb.x) {
+        const float h = S->step, thr = S->threshold;
+        const uint n_tf = F->light_tf_size;
+        const int skip = (F->flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+        const float len = tb.y - tb.x;
+        const int n_full = (int)floor(len / h);
+        const float last = len - (float)n_full * h;
+        float A = 0.0f;
+        float t_visible = -UMBRA_INF;
+        /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. */
+        for (int k = 0; k <= n_full;) {
+            const float seg = k < n_full ? h : last;
+            if (!(seg > 0.0f))
+                break;
+            const float t_start = tb.x + (float)k * h;
+            const float t_mid = t_start + 0.5f * seg;
+            const float3 q = o + t_mid * d;
+            /* The brick table is read once per brick crossed (t_visible), not per sample. */
+            if (skip && k < n_full && t_mid >= t_visible) {
+                const float t_exit = brick_exit(g, o, d, t_mid);
+                if (!light_bricks[brick_index(g, q)]) {
+                    k = next_sample_after(tb.x, h, 0.5f, t_exit, k);
+                    continue;
+                }
+                t_visible = t_exit;
+            }
+            float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
+            if (k == n_full)
+                c = alpha_for_fraction(c, seg / h);
+            const float a = c.w;
+            if (A + (1.0f - A) * a > thr) {
+                /* ln(1 - a) is -inf for a == 1: the crossing is then at the segment's start. */
+                const float frac = log((1.0f - thr) / (1.0f - A)) / log(1.0f - a);
+                depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
+                break;
+            }
+            A += (1.0f - A) * a;
+            ++k;
+        }
+    }
+    map[y * n + x] = depth;
+}
+
+/* Fraction of the taps around p's texel whose stored depth p does not lie beyond. */
+inline float threshold_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
+{
+    const float3 m = ls_world_to_map(S, p);
+    int2 base;
+    if (!ls_base_texel(S, m.xy, &base))
+        return 1.0f;
+    const uint taps = S->taps;
+    const float s = m.z - S->depth_bias;
+    float lit = 0.0f;
+    for (uint j = 0; j < taps; ++j) {
+        const int i = ls_texel_index(S, base + ls_taps[j]);
+        lit += (i < 0 || !(s > map[i])) ? 1.0f : 0.0f;
+    }
+    return lit / (float)taps;
+}
+
+#define SHADOW_FACTOR(sr, p) ((float3)(threshold_lookup(S, shadow_map, (p))))

@@ -1,0 +1,348 @@
+/* tests/shadow_map_test.h: checks that the single-layer light-space maps (test_threshold.c,
+ * test_cssm.c) share, written once and run per technique:
+ *  - a homogeneous slab scene (the whole box filled with one value) and points placed at texel
+ *    centres of the map, for analytic comparisons;
+ *  - every light that stresses the projection (axis-aligned directions both ways, grazing
+ *    directions, point lights on a face, at a corner, just outside, inside empty space and inside
+ *    material) gives finite factors in [0,1] in queries and images, some shadow, and exactly 1
+ *    where nothing lies between point and light;
+ *  - a camera move re-uses the map, a light change rebuilds it, and the reported memory is the
+ *    map's size;
+ *  - the image on the spheres scene stays within a stated mean error of the exact reference. */
+#ifndef UMBRA_TESTS_SHADOW_MAP_TEST_H
+#define UMBRA_TESTS_SHADOW_MAP_TEST_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+#include "test_util.h"
+
+/* The slab: the whole box of MT_NX x MT_NY x MT_NZ voxels (spacing 1) holds one value. */
+#define MT_NX 48u
+#define MT_NY 32u
+#define MT_NZ 48u
+
+static inline umbra_light mt_directional(float x, float y, float z)
+{
+    umbra_light l;
+    memset(&l, 0, sizeof l);
+    l.type = UMBRA_LIGHT_DIRECTIONAL;
+    l.direction[0] = x;
+    l.direction[1] = y;
+    l.direction[2] = z;
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    return l;
+}
+
+static inline umbra_light mt_point(float x, float y, float z)
+{
+    umbra_light l = mt_directional(0.0f, -1.0f, 0.0f);
+    l.type = UMBRA_LIGHT_POINT;
+    l.position[0] = x;
+    l.position[1] = y;
+    l.position[2] = z;
+    return l;
+}
+
+/* A constant transfer function of colour (r, g, b) and per-voxel alpha a. */
+static inline umbra_transfer_function mt_tf(umbra_context ctx, float r, float g, float b, float a)
+{
+    float rgba[8] = {r, g, b, a, r, g, b, a};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
+    return tf;
+}
+
+static inline umbra_shadow_desc mt_shadow(umbra_shadow_technique t, uint32_t map_size,
+                                          uint32_t taps)
+{
+    umbra_shadow_desc s;
+    umbra_shadow_desc_init(&s);
+    s.technique = t;
+    s.map_size = map_size;
+    s.taps = taps;
+    return s;
+}
+
+/* A renderer on volume and tf, lit by light, with default options of the given transmission. */
+static inline umbra_renderer mt_renderer(umbra_context ctx, umbra_volume volume,
+                                         umbra_transfer_function tf, const umbra_light *light,
+                                         umbra_transmission transmission)
+{
+    umbra_renderer r = NULL;
+    umbra_render_desc o;
+    umbra_render_desc_init(&o);
+    o.transmission = transmission;
+    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_volume(r, volume), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_light(r, light), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+    return r;
+}
+
+/* World point at the centre of texel (i, j) of an orthographic map, at distance `along` along the
+ * light direction (the map's w axis) from the origin. The map must have been built. */
+static inline void mt_texel_point(umbra_renderer r, uint32_t i, uint32_t j, float along, float p[3])
+{
+    const UmbraShadow *S = &r->shadow_params;
+    assert_int_equal(S->ls_mode, UMBRA_LS_ORTHO);
+    float n = (float)S->map_size;
+    float a = S->ls_window[0] + ((float)i + 0.5f) / (n * S->ls_window[2]);
+    float b = S->ls_window[1] + ((float)j + 0.5f) / (n * S->ls_window[3]);
+    for (int k = 0; k < 3; ++k)
+        p[k] = a * S->ls_u[k] + b * S->ls_v[k] + along * S->ls_w[k];
+}
+
+static inline int mt_finite_unit(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i]) || v[i] < 0.0f || v[i] > 1.0f)
+            return 0;
+    return 1;
+}
+
+/* Mean over pixels of the mean absolute RGB difference. */
+static inline double mt_mean_abs_error(const float *a, const float *b, size_t pixels)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < pixels; ++i)
+        for (int c = 0; c < 3; ++c)
+            sum += fabs((double)a[4 * i + c] - (double)b[4 * i + c]) / 3.0;
+    return sum / (double)pixels;
+}
+
+/* ---- lights that stress the projection ------------------------------------------------------ */
+
+/* A 32^3 volume (box [-16, 16]^3) holding a ball of radius 6 voxels centred at (7, -6, 5), with
+ * a smooth edge, and a coloured transfer function that is empty at 0: the box's middle is clear
+ * for 4 voxels around the origin. For each light, queries of a cloud of points in and around the
+ * box and a 40x40 image must be finite and in [0,1]; points between a light and the box, and
+ * points 1.5 voxels from a point light at the origin, must be exactly lit (nothing lies between
+ * them and the light). */
+static inline void mt_check_stress_lights(umbra_context ctx, umbra_shadow_desc shadow)
+{
+    enum { N = 32 };
+    const float h = 0.5f * N, ball[3] = {7.0f, -6.0f, 5.0f};
+    float *data = malloc((size_t)N * N * N * sizeof *data);
+    assert_non_null(data);
+    for (int z = 0; z < N; ++z)
+        for (int y = 0; y < N; ++y)
+            for (int x = 0; x < N; ++x) {
+                float dx = x + 0.5f - h - ball[0], dy = y + 0.5f - h - ball[1];
+                float dz = z + 0.5f - h - ball[2];
+                float d = sqrtf(dx * dx + dy * dy + dz * dz) - 6.0f;
+                data[(z * N + y) * N + x] = fminf(1.0f, fmaxf(0.0f, 0.5f - d));
+            }
+    umbra_volume_desc vd;
+    umbra_volume_desc_init(&vd);
+    vd.data = data;
+    vd.type = UMBRA_FLOAT32;
+    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
+    vd.value_range_given = 1;
+    vd.value_min = 0.0f;
+    vd.value_max = 1.0f;
+    umbra_volume vol = NULL;
+    assert_int_equal(umbra_volume_create(ctx, &vd, &vol), UMBRA_SUCCESS);
+    free(data);
+    const float rgba[8] = {0, 0, 0, 0, 0.9f, 0.4f, 0.1f, 0.3f};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
+    const float cam_dir[3] = {0.6f, 0.45f, 1.0f};
+    umbra_camera camera = umbra_camera_orbit(cam_dir, 1.74f * N, 30.0f);
+    umbra_render_desc o;
+    umbra_render_desc_init(&o);
+    o.transmission = UMBRA_TRANSMISSION_COLORED;
+    o.ground_plane = 1;
+    struct {
+        umbra_light light;
+        const char *what;
+    } cases[] = {
+        {mt_directional(0, -1, 0), "down the y axis"},
+        {mt_directional(0, 1, 0), "up the y axis"},
+        {mt_directional(1, 0, 0), "along +x"},
+        {mt_directional(0, 0, -1), "along -z"},
+        {mt_directional(1, -1e-3f, 0), "grazing, 0.06 degrees"},
+        {mt_directional(0.3f, 1e-6f, -1), "grazing, 6e-5 degrees"},
+        {mt_point(0, h, 0), "point on the top face"},
+        {mt_point(-h, -h, h), "point on a corner"},
+        {mt_point(h + 0.01f, 3, -2), "point just outside a face"},
+        {mt_point(0, 0, 0), "point inside, centre"},
+        {mt_point(5, -4, 3), "point inside the ball"},
+    };
+    enum { CLOUD = 7 * 7 * 7, W = 40, H = 40 };
+    float *pts = malloc(CLOUD * 3 * sizeof *pts), *rgb = malloc(CLOUD * 3 * sizeof *rgb);
+    float *img = malloc(W * H * 4 * sizeof *img);
+    assert_non_null(pts);
+    assert_non_null(rgb);
+    assert_non_null(img);
+    for (int i = 0; i < CLOUD; ++i) {
+        pts[3 * i + 0] = -1.4f * h + 2.8f * h * (float)(i % 7) / 6.0f;
+        pts[3 * i + 1] = -1.4f * h + 2.8f * h * (float)(i / 7 % 7) / 6.0f;
+        pts[3 * i + 2] = -1.4f * h + 2.8f * h * (float)(i / 49) / 6.0f;
+    }
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        const umbra_light *l = &cases[c].light;
+        umbra_renderer r = mt_renderer(ctx, vol, tf, l, UMBRA_TRANSMISSION_COLORED);
+        assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_set_camera(r, &camera), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_query_shadow(r, pts, CLOUD, rgb), UMBRA_SUCCESS);
+        if (!mt_finite_unit(rgb, CLOUD * 3))
+            fail_msg("%s: a shadow factor is not finite or outside [0,1]", cases[c].what);
+        float fmin = 1.0f;
+        for (size_t i = 0; i < CLOUD * 3; ++i)
+            fmin = fminf(fmin, rgb[i]);
+        if (!(fmin < 0.9f)) /* the ball shadows some of the cloud */
+            fail_msg("%s: no point of the cloud is shadowed (min factor %g)", cases[c].what, fmin);
+        assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+        for (size_t i = 0; i < (size_t)W * H * 4; ++i)
+            if (!isfinite(img[i]) || img[i] < 0.0f)
+                fail_msg("%s: pixel value %g at %zu", cases[c].what, img[i], i / 4);
+
+        /* Points with nothing between them and the light. */
+        float lit[6 * 3];
+        size_t nlit = 0;
+        if (l->type == UMBRA_LIGHT_DIRECTIONAL) {
+            float dl = sqrtf(l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] +
+                             l->direction[2] * l->direction[2]);
+            /* Upwind of the box by 2 box diagonals, at a few lateral offsets. */
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a)
+                    lit[3 * k + a] = -l->direction[a] / dl * 4.0f * 1.74f * h + (k - 1) * 3.0f;
+            nlit = 3;
+        } else {
+            const float *P = l->position;
+            int inside = fabsf(P[0]) < h && fabsf(P[1]) < h && fabsf(P[2]) < h;
+            /* At the clear middle: points around it; outside the box: points farther out. */
+            if (inside && fabsf(P[0]) + fabsf(P[1]) + fabsf(P[2]) < 1.0f) {
+                const float off[6][3] = {{1.5f, 0, 0}, {-1.5f, 0, 0}, {0, 1.5f, 0},
+                                         {0, -1.5f, 0}, {0, 0, 1.5f}, {0, 0, -1.5f}};
+                for (int k = 0; k < 6; ++k)
+                    for (int a = 0; a < 3; ++a)
+                        lit[3 * k + a] = P[a] + off[k][a];
+                nlit = 6;
+            } else if (!inside) {
+                for (int a = 0; a < 3; ++a) {
+                    float out = P[a] > 0.0f ? 1.0f : -1.0f;
+                    lit[a] = P[a] + (fabsf(P[a]) >= h - 0.01f ? out * 2.0f : 0.0f);
+                    lit[3 + a] = P[a] * 1.8f + (a == 1 ? 1.0f : 0.0f);
+                }
+                nlit = 2;
+            }
+        }
+        if (nlit) {
+            float f[6 * 3];
+            assert_int_equal(umbra_renderer_query_shadow(r, lit, nlit, f), UMBRA_SUCCESS);
+            for (size_t i = 0; i < nlit * 3; ++i)
+                if (f[i] != 1.0f)
+                    fail_msg("%s: point %zu (%g, %g, %g) has nothing between it and the light "
+                             "but factor %g", cases[c].what, i / 3, lit[i / 3 * 3],
+                             lit[i / 3 * 3 + 1], lit[i / 3 * 3 + 2], f[i]);
+        }
+        umbra_renderer_release(r);
+    }
+    free(pts);
+    free(rgb);
+    free(img);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(vol);
+}
+
+/* ---- caching and memory --------------------------------------------------------------------- */
+
+/* Camera moves re-use the map; a light change and a light transfer function change rebuild it;
+ * the memory is map_size^2 * values * 4 bytes with values per texel as given (for the spheres'
+ * coloured light in coloured mode, and for grey mode). */
+static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_desc shadow,
+                                             uint32_t values_colored, uint32_t values_grey)
+{
+    umbra_scene scene;
+    assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &scene), UMBRA_SUCCESS);
+    umbra_renderer r = mt_renderer(ctx, scene.volume, scene.tf, &scene.light,
+                                   UMBRA_TRANSMISSION_COLORED);
+    enum { W = 32, H = 32 };
+    float img[W * H * 4];
+    umbra_render_stats st;
+    const size_t texels = (size_t)shadow.map_size * shadow.map_size;
+    assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.shadow_rebuilt, 1);
+    assert_true(st.shadow_build_ms > 0.0);
+    assert_int_equal(st.shadow_memory_bytes, texels * values_colored * 4);
+
+    umbra_camera cam = scene.camera;
+    cam.eye[0] += 10.0f;
+    assert_int_equal(umbra_renderer_set_camera(r, &cam), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.shadow_rebuilt, 0);
+    assert_true(st.shadow_build_ms == 0.0);
+    assert_int_equal(st.shadow_memory_bytes, texels * values_colored * 4);
+
+    umbra_light l = scene.light;
+    l.direction[0] += 0.1f;
+    assert_int_equal(umbra_renderer_set_light(r, &l), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.shadow_rebuilt, 1);
+
+    umbra_transfer_function grey = mt_tf(ctx, 0.5f, 0.5f, 0.5f, 0.05f);
+    assert_int_equal(umbra_renderer_set_light_transfer_function(r, grey), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.shadow_rebuilt, 1);
+    assert_int_equal(st.light_channels, 1);
+    assert_int_equal(st.shadow_memory_bytes, texels * values_grey * 4);
+    assert_int_equal(umbra_renderer_set_light_transfer_function(r, NULL), UMBRA_SUCCESS);
+
+    umbra_render_desc o;
+    umbra_render_desc_init(&o);
+    o.transmission = UMBRA_TRANSMISSION_GREY;
+    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.shadow_rebuilt, 1);
+    assert_int_equal(st.light_channels, 1);
+    assert_int_equal(st.shadow_memory_bytes, texels * values_grey * 4);
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(grey);
+    umbra_scene_release(&scene);
+}
+
+/* ---- against the reference ------------------------------------------------------------------ */
+
+/* Renders the spheres scene (48^3, its light, camera and coloured options, with the ground
+ * plane) at 96x96 with shadow and with the exact reference; returns the mean absolute error. */
+static inline double mt_error_vs_reference(umbra_context ctx, umbra_shadow_desc shadow)
+{
+    enum { W = 96, H = 96 };
+    umbra_scene scene;
+    assert_int_equal(umbra_scene_create(ctx, "spheres", 48, &scene), UMBRA_SUCCESS);
+    umbra_renderer r = mt_renderer(ctx, scene.volume, scene.tf, &scene.light,
+                                   scene.options.transmission);
+    assert_int_equal(umbra_renderer_set_options(r, &scene.options), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_camera(r, &scene.camera), UMBRA_SUCCESS);
+    float *a = malloc(W * H * 4 * sizeof *a), *b = malloc(W * H * 4 * sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    umbra_shadow_desc ref;
+    umbra_shadow_desc_init(&ref);
+    ref.technique = UMBRA_SHADOW_REFERENCE;
+    assert_int_equal(umbra_renderer_set_shadow(r, &ref), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, a), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, W, H, b), UMBRA_SUCCESS);
+    double e = mt_mean_abs_error(a, b, (size_t)W * H);
+    free(a);
+    free(b);
+    umbra_renderer_release(r);
+    umbra_scene_release(&scene);
+    return e;
+}
+
+#endif
