@@ -50,7 +50,7 @@
 /* Adaptive run counts: a setting whose first frame (build + render) takes longer than these gets
  * fewer timed runs, so that the 4096^2 maps and the exact reference do not dominate the sweep. */
 #define SLOW_MS 3000.0
-#define VERY_SLOW_MS 20000.0
+#define VERY_SLOW_MS 12000.0
 
 /* ---- the settings swept ------------------------------------------------------------------------ */
 
@@ -67,17 +67,6 @@ enum {
     H_COUNT
 };
 
-static const char *const headline_names[H_COUNT] = {
-    "",
-    "none (unshadowed)",
-    "reference, exact (shadow-ray step = scene's, 0.25 voxel)",
-    "reference, shadow-ray step 1 voxel",
-    "threshold map 1024², opacity 0.5",
-    "CSSM 1024², 13 taps",
-    "deep map 1024², ε 0.02",
-    "deep map 1024², 3 nodes per channel",
-    "convolution, slice distance 1 voxel (ICS)",
-};
 
 typedef struct config {
     umbra_shadow_desc desc;
@@ -90,6 +79,7 @@ typedef struct config {
 typedef struct config_list {
     config items[MAX_CONFIGS];
     int count;
+    uint32_t headline_map; /* the map size of the headline settings: 1024, or 512 with --quick */
 } config_list;
 
 static config *add_config(config_list *L, umbra_shadow_technique t)
@@ -139,7 +129,7 @@ static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float thr
     snprintf(c->label, sizeof c->label, "%u², opacity %g%s", map, threshold,
              taps > 1 ? (taps == 7 ? ", 7 taps" : taps == 13 ? ", 13 taps" : ", 21 taps") : "");
     snprintf(c->params, sizeof c->params, "map_size=%u;taps=%u;threshold=%g", map, taps, threshold);
-    if (map == 1024 && taps == 1 && threshold == 0.5f)
+    if (map == L->headline_map && taps == 1 && threshold == 0.5f)
         c->headline = H_THRESHOLD;
 }
 
@@ -152,7 +142,7 @@ static void add_cssm(config_list *L, uint32_t map, uint32_t taps)
     c->desc.taps = taps;
     snprintf(c->label, sizeof c->label, "%u², %u taps", map, taps);
     snprintf(c->params, sizeof c->params, "map_size=%u;taps=%u;seed=%u", map, taps, c->desc.seed);
-    if (map == 1024 && taps == 13)
+    if (map == L->headline_map && taps == 13)
         c->headline = H_CSSM;
 }
 
@@ -172,7 +162,7 @@ static void add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes, ui
              prefilter == 5 ? ", 5-tap prefilter" : "");
     snprintf(c->params, sizeof c->params, "map_size=%u;epsilon=%g;max_nodes=%u;prefilter=%u", map,
              eps, nodes, prefilter);
-    if (map == 1024 && eps == 0.02f && prefilter == 1)
+    if (map == L->headline_map && eps == 0.02f && prefilter == 1)
         c->headline = nodes == 0 ? H_DEEP : nodes == 3 ? H_DEEP3 : 0;
 }
 
@@ -197,14 +187,20 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
 }
 
 /* The sweep. The exact reference comes first (its image is every other row's yardstick), then
- * none (the unshadowed frame every overhead is measured against). */
-static void build_configs(int quick, uint32_t max_map, float exact_step, config_list *L)
+ * none (the unshadowed frame every overhead is measured against). Scenes marked `papers yes` also
+ * get the seed papers' settings: 4096^2 maps for the CSSM paper's Tables 3-4 (threshold, deep with
+ * 3 nodes per channel, CSSM with 13 taps) and the deep-map paper's Table 1 (128^2-512^2 at
+ * epsilon 0.02 and 0.06 with the 5-tap pre-filter); the other scenes stop at 2048^2, because one
+ * 4096^2 deep map takes minutes to build on a 2-core CPU. */
+static void build_configs(int quick, int papers, uint32_t max_map, float exact_step,
+                          config_list *L)
 {
     static const uint32_t maps_full[] = {512, 1024, 2048, 4096};
-    static const uint32_t maps_quick[] = {512, 1024};
+    static const uint32_t maps_quick[] = {512};
     const uint32_t *maps = quick ? maps_quick : maps_full;
-    size_t nmaps = quick ? 2 : 4;
+    size_t nmaps = quick ? 1 : (papers ? 4 : 3);
     L->count = 0;
+    L->headline_map = quick ? 512 : 1024;
     add_reference(L, exact_step, 1);
     add_none(L);
     if (quick) {
@@ -225,15 +221,15 @@ static void build_configs(int quick, uint32_t max_map, float exact_step, config_
     for (size_t i = 0; i < nmaps; ++i)
         if (maps[i] <= max_map)
             add_cssm(L, maps[i], 13);
-    add_cssm(L, 1024, 7);
+    add_cssm(L, L->headline_map, 7);
     if (!quick)
         add_cssm(L, 1024, 21);
-    for (size_t i = 0; i < nmaps; ++i)
+    /* Unbounded deep maps stop at 2048^2: at 4096^2 one build takes about 3 minutes here. */
+    for (size_t i = 0; i < nmaps && i < 3; ++i)
         if (maps[i] <= max_map)
             add_deep(L, maps[i], 0.02f, 0, 1);
-    add_deep(L, 1024, 0.02f, 3, 1);
+    add_deep(L, L->headline_map, 0.02f, 3, 1);
     if (!quick) {
-        /* CSSM paper Tables 3-4: 3 nodes per channel at 2048^2 and 4096^2 too. */
         for (size_t i = 2; i < nmaps; ++i)
             if (maps[i] <= max_map)
                 add_deep(L, maps[i], 0.02f, 3, 1);
@@ -242,29 +238,30 @@ static void build_configs(int quick, uint32_t max_map, float exact_step, config_
         add_deep(L, 1024, 0.01f, 0, 1);
         add_deep(L, 1024, 0.06f, 0, 1);
         add_deep(L, 1024, 0.1f, 0, 1);
+    }
+    if (!quick && papers) {
         add_deep(L, 1024, 0.02f, 0, 5);
-        /* Deep-map paper Table 1: 128^2 to 512^2 at epsilon 0.02 and 0.06, 5-tap pre-filter. */
         static const uint32_t small[] = {128, 256, 512};
         for (size_t i = 0; i < 3; ++i) {
             add_deep(L, small[i], 0.02f, 0, 5);
             add_deep(L, small[i], 0.06f, 0, 5);
         }
     }
+    /* Convolution renders every frame slice by slice: a frame costs seconds to a minute on the
+     * CPU, so the sweep samples its parameter plane rather than covering it (the convolution
+     * bench covers the paper's Table 1 grid on a small image). */
     if (quick) {
         add_convolution(L, 1.0f, 0, 0);
         add_convolution(L, 2.0f, 0, 0);
         add_convolution(L, 2.0f, 1, 0);
-        add_convolution(L, 2.0f, 0, 1);
     } else {
-        static const float slices[] = {0.25f, 0.5f, 1.0f, 2.0f};
-        for (size_t i = 0; i < 4; ++i)
-            add_convolution(L, slices[i], 0, 0);
-        for (size_t i = 1; i < 4; ++i) {
-            add_convolution(L, slices[i], 1, 0);
-            add_convolution(L, slices[i], 3, 0);
-            add_convolution(L, slices[i], 0, 1);
-        }
-        add_convolution(L, 1.0f, 3, 1);
+        add_convolution(L, 0.5f, 0, 0);
+        add_convolution(L, 1.0f, 0, 0);
+        add_convolution(L, 2.0f, 0, 0);
+        add_convolution(L, 2.0f, 1, 0);
+        add_convolution(L, 2.0f, 3, 0);
+        add_convolution(L, 1.0f, 0, 1);
+        add_convolution(L, 2.0f, 0, 1);
         add_convolution(L, 2.0f, 3, 1);
     }
 }
@@ -298,6 +295,7 @@ typedef struct options {
     const char *images;      /* none | headline | all */
     char out[2048], cache_dir[2100], scene_dir[2048], main_scene[SCENE_NAME_MAX];
     char scenes[1024];       /* comma-separated names, "" for all */
+    char techniques[256];    /* comma-separated technique names, "" for all */
     const char *device;
     uint32_t max_map;
 } options;
@@ -558,10 +556,13 @@ static outcome measure(bench_run *B, scene_ctx *S, const char *scene, const conf
     m->stats = first;
     double t0 = first.shadow_build_ms + first.render_ms;
     int runs = B->o.runs, warmup = B->o.warmup - 1;
-    if (t0 > VERY_SLOW_MS) {
+    /* --quick is for a look, not for the record: it cuts the slow settings' runs sooner. */
+    double slow = B->o.quick ? SLOW_MS / 2.0 : SLOW_MS;
+    double very_slow = B->o.quick ? VERY_SLOW_MS / 2.0 : VERY_SLOW_MS;
+    if (t0 > very_slow) {
         runs = 0;
         warmup = 0;
-    } else if (t0 > SLOW_MS) {
+    } else if (t0 > slow) {
         runs = runs < 2 ? runs : 2;
         warmup = 0;
     }
@@ -686,8 +687,11 @@ static void save_image(bench_run *B, const char *scene, const config *c, uint32_
     snprintf(dir, sizeof dir, "%s/images/%s", B->o.out, scene);
     if (mkdirs(dir) != 0)
         return;
-    snprintf(name, sizeof name, "%s-%s", umbra_shadow_technique_name(c->desc.technique),
-             c->params);
+    if (strcmp(c->params, "-") == 0)
+        snprintf(name, sizeof name, "%s", umbra_shadow_technique_name(c->desc.technique));
+    else
+        snprintf(name, sizeof name, "%s-%s", umbra_shadow_technique_name(c->desc.technique),
+                 c->params);
     sanitize(name, 1);
     snprintf(path, sizeof path, "%s/%s.png", dir, name);
     if (umbra_image_write(B->ctx, path, w, h, rgba) != UMBRA_SUCCESS) {
@@ -753,11 +757,30 @@ static float exact_step(const scene_spec *s)
     return s->reference_step > 0.0f ? s->reference_step : 0.25f;
 }
 
+static int in_list(const char *list, const char *name);
+
+/* The sweep for one scene, less the techniques --techniques leaves out (the exact reference and
+ * the unshadowed frame always stay: every other row is measured against them). */
+static void scene_configs(const options *o, const scene_spec *s, config_list *L)
+{
+    build_configs(o->quick, s->papers, o->max_map, exact_step(s), L);
+    if (!o->techniques[0])
+        return;
+    int n = 0;
+    for (int i = 0; i < L->count; ++i) {
+        const config *c = &L->items[i];
+        if (c->exact || c->desc.technique == UMBRA_SHADOW_NONE ||
+            in_list(o->techniques, umbra_shadow_technique_name(c->desc.technique)))
+            L->items[n++] = *c;
+    }
+    L->count = n;
+}
+
 static void run_scene(bench_run *B, int si)
 {
     const scene_spec *spec = &B->scenes[si];
     config_list L;
-    build_configs(B->o.quick, B->o.max_map, exact_step(spec), &L);
+    scene_configs(&B->o, spec, &L);
     scene_ctx S;
     if (open_scene(B, si, &S) != 0) {
         B->run_index += L.count;
@@ -1136,11 +1159,13 @@ static void fmt_ratio(double x, char *buf, size_t size)
 static void headline_table(const bench_run *B, FILE *f, int si)
 {
     fprintf(f, "| technique | render overhead over unshadowed | map build / unshadowed frame | "
-               "RMSE | SSIM | memory | speed-up over exact reference |\n"
-               "|---|---|---|---|---|---|---|\n");
+               "RMSE | SSIM | memory | speed-up over exact reference |%s\n"
+               "|---|---|---|---|---|---|---|%s\n", si < 0 ? " scenes |" : "",
+            si < 0 ? "---|" : "");
     for (int h = H_NONE; h < H_COUNT; ++h) {
         double lo = 0, lb = 0, rm = 0, ss = 0, lmem = 0, lsp = 0;
         int n = 0, nb = 0, nmem = 0;
+        const result *any = NULL;
         for (int s = 0; s < B->scene_count; ++s) {
             if (si >= 0 && s != si)
                 continue;
@@ -1159,6 +1184,7 @@ static void headline_table(const bench_run *B, FILE *f, int si)
                 ++nmem;
             }
             lsp += log(r->reference_ms / r->total_ms);
+            any = r;
             ++n;
         }
         if (n == 0)
@@ -1174,8 +1200,16 @@ static void headline_table(const bench_run *B, FILE *f, int si)
         else
             snprintf(m, sizeof m, "0");
         fmt_ratio(exp(lsp / n), sp, sizeof sp);
-        fprintf(f, "| %s | %s | %s | %.4f | %.4f | %s | %s |\n", headline_names[h], o, b, rm / n,
-                ss / n, m, sp);
+        char name[160];
+        if (h == H_NONE)
+            snprintf(name, sizeof name, "none (unshadowed)");
+        else
+            snprintf(name, sizeof name, "%s, %s", umbra_shadow_technique_name(any->cfg.desc.technique),
+                     any->cfg.label);
+        fprintf(f, "| %s | %s | %s | %.4f | %.4f | %s | %s |", name, o, b, rm / n, ss / n, m, sp);
+        if (si < 0)
+            fprintf(f, " %d |", n);
+        fprintf(f, "\n");
     }
 }
 
@@ -1211,7 +1245,7 @@ static void write_headline(bench_run *B)
         headline_table(B, f, ms);
     }
     fprintf(f, "\n**All %d scenes** (%s): ratios, memory and speed-ups are geometric means, RMSE "
-               "and SSIM arithmetic means:\n\n", nscenes, names);
+               "and SSIM arithmetic means over the scenes where the setting ran:\n\n", nscenes, names);
     headline_table(B, f, -1);
     fprintf(f, "\nRender overhead: render time with shadows over the unshadowed render of the same "
                "view; build: the shadow structure's construction over one unshadowed frame (paid "
@@ -1514,12 +1548,14 @@ static void usage(FILE *f)
         "  exact reference: times (medians of N), memory, RMSE/PSNR/max/SSIM; writes\n"
         "  accuracy.csv, summary.md, headline.md, papers.md and plots/*.png into --out\n"
         "  --quick          small images (longer side %u), scenes marked 'quick yes', a reduced\n"
-        "                   parameter set, 3 runs: a few minutes on 2 cores\n"
+        "                   parameter set: a few minutes on 2 cores\n"
         "  --scenes A,B     only these scenes (file stems in the scene directory)\n"
+        "  --techniques A,B only these techniques (the exact reference and none always run)\n"
         "  --out DIR        output directory (default: <source>/bench/results/accuracy, or\n"
         "                   accuracy-quick/ next to umbra-bench with --quick)\n"
-        "  --runs N         timed runs per setting (default 5, --quick 3); fewer for settings\n"
-        "                   whose first frame takes over %.0f s (2) or %.0f s (0: first frame)\n"
+        "  --runs N         timed runs per setting (default 3); fewer for settings\n"
+        "                   whose first frame takes over %.0f s (2) or %.0f s (0: first frame);\n"
+        "                   half those with --quick\n"
         "  --warmup N       warm-up frames per setting, the first one included (default 1)\n"
         "  --max-map N      leave out light-space maps larger than N^2 (default 4096)\n"
         "  --images MODE    PNGs under DIR/images: none, headline (default), all\n"
@@ -1575,6 +1611,21 @@ static int parse_options(int argc, char **argv, options *o)
         } else if (strcmp(a, "--scenes") == 0 && v) {
             snprintf(o->scenes, sizeof o->scenes, "%s", v);
             ++i;
+        } else if (strcmp(a, "--techniques") == 0 && v) {
+            snprintf(o->techniques, sizeof o->techniques, "%s", v);
+            for (char *t = o->techniques; *t;) {
+                size_t len = strcspn(t, ",");
+                char name[64];
+                umbra_shadow_technique id;
+                snprintf(name, sizeof name, "%.*s", (int)(len < 63 ? len : 63), t);
+                if (umbra_shadow_technique_parse(name, &id) != UMBRA_SUCCESS) {
+                    fprintf(stderr, "umbra-bench accuracy: --techniques: unknown technique '%s'\n",
+                            name);
+                    return -1;
+                }
+                t += len + (t[len] == ',');
+            }
+            ++i;
         } else if (strcmp(a, "--out") == 0 && v) {
             snprintf(o->out, sizeof o->out, "%s", v);
             ++i;
@@ -1598,7 +1649,7 @@ static int parse_options(int argc, char **argv, options *o)
         }
     }
     if (o->runs < 0)
-        o->runs = o->quick ? 3 : 5;
+        o->runs = 3;
     if (!o->out[0]) {
         /* --quick results are for looking at, not for committing: next to the executable (the
          * build directory), else in the working directory. */
@@ -1712,7 +1763,7 @@ int bench_accuracy(int argc, char **argv)
     B.run_total = 0;
     for (int si = 0; si < B.scene_count; ++si) {
         config_list L;
-        build_configs(B.o.quick, B.o.max_map, exact_step(&B.scenes[si]), &L);
+        scene_configs(&B.o, &B.scenes[si], &L);
         if (B.o.list) {
             printf("%s%s: %s (%s)\n", B.scenes[si].name, B.present[si] ? "" : " [volume absent]",
                    B.scenes[si].description, B.scenes[si].volume);

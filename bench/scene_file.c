@@ -189,7 +189,7 @@ static const float_key float_keys[] = {
 
 static const char *const other_keys[] = {
     "volume", "tf", "light_tf", "description", "units", "camera", "light", "size",
-    "transmission", "shading", "ground", "quick",
+    "transmission", "shading", "ground", "quick", "papers",
 };
 
 #define KEY_COUNT (sizeof float_keys / sizeof float_keys[0] + \
@@ -358,6 +358,8 @@ static int parse_line(parser *p, char **tok, int ntok, const char *dir, const ch
         return on_off(p, key, tok, ntok, &s->ground);
     if (strcmp(key, "quick") == 0)
         return on_off(p, key, tok, ntok, &s->quick);
+    if (strcmp(key, "papers") == 0)
+        return on_off(p, key, tok, ntok, &s->papers);
     return parse_error(p, "key '%s' has no parser", key); /* unreachable: every key is handled above */
 }
 

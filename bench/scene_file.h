@@ -28,6 +28,8 @@
  *   ground on | off / ground_color R G B / ground_offset F
  *   background R G B A          premultiplied
  *   quick yes | no              whether --quick includes this scene (default no)
+ *   papers yes | no             whether the full sweep adds the seed papers' settings (4096^2
+ *                               maps, the deep-map paper's Table 1) here (default no)
  *
  * A built-in volume takes every item the file leaves out from the built-in scene (its camera,
  * light and options). A volume file needs tf, light and eye; what else is left out takes the
@@ -71,7 +73,7 @@ typedef struct scene_spec {
     int have_kd, have_ks, have_shininess, have_ambient, have_ground_color, have_ground_offset,
         have_background;
     float kd, ks, shininess, ambient[3], ground_color[3], ground_offset, background[4];
-    int quick;
+    int quick, papers;
 
     uint64_t hash;                     /* FNV-1a of the scene file and its tf files' contents */
 } scene_spec;
