@@ -289,7 +289,7 @@ static void write_results(const options *o, const char *scene, const char *machi
                "technique (shadow rays, step 0.25) ray cast at 0.2 voxel\n\n",
             scene, o->width, o->height, o->cone, fg, machine, device, o->runs, o->warmup);
     for (int pi = 0; pi < 2; ++pi) {
-        const char *title[3] = {"time per frame (ms)", "error vs finest (fg in brackets)",
+        const char *title[3] = {"time per frame, ms: median (min)", "error vs finest (fg in brackets)",
                                 "error vs reference (fg in brackets)"};
         for (int tab = 0; tab < 3; ++tab) {
             fprintf(f, "### %s ICS / SCS: %s\n\n| slice distance | 0 | 1 | 2 | 3 sub-samples |\n"
@@ -299,7 +299,7 @@ static void write_results(const options *o, const char *scene, const char *machi
                 for (int n = 0; n < NS; ++n) {
                     const row *q = &rows[(pi * ND + di) * NS + n];
                     if (tab == 0)
-                        fprintf(f, " %.0f |", q->t.median);
+                        fprintf(f, " %.0f (%.0f) |", q->t.median, q->t.min);
                     else if (tab == 1)
                         fprintf(f, " %.4f (%.4f) |", q->mae_finest, q->fg_finest);
                     else
