@@ -48,11 +48,13 @@
 #define MAX_SCENES 32
 #define QUICK_MAX_SIDE 256u
 /* Adaptive run counts: a setting whose first frame (build + render) takes longer than these gets
- * fewer timed runs, so that the 4096^2 maps and the exact reference do not dominate the sweep. */
+ * fewer timed runs (2, then 1), so that the 4096^2 maps do not dominate the sweep. There is always
+ * at least one timed frame after the first: the first can carry one-time work (a deep map's block
+ * pool growing to fit, a table built on first use) that a rebuild does not repeat. */
 #define SLOW_MS 3000.0
 #define VERY_SLOW_MS 12000.0
 
-/* ---- the settings swept ------------------------------------------------------------------------ */
+/* ---- the settings swept ---------------------------------------------------------------------- */
 
 /* Rows of the headline table: one representative setting per technique. */
 enum {
@@ -174,8 +176,8 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
     c->desc.slice_distance = slice;
     c->desc.subsamples = sub;
     c->desc.preintegrated = pre;
-    snprintf(c->label, sizeof c->label, "%s slice %g%s", pre ? (sub ? "pre-int. SCS" : "pre-int. ICS")
-                                                             : (sub ? "SCS" : "ICS"),
+    const char *kind = pre ? (sub ? "pre-int. SCS" : "pre-int. ICS") : (sub ? "SCS" : "ICS");
+    snprintf(c->label, sizeof c->label, "%s slice %g%s", kind,
              slice, sub ? (sub == 1 ? ", 1 sub-sample" : sub == 2 ? ", 2 sub-samples"
                                                                   : ", 3 sub-samples")
                         : "");
@@ -187,18 +189,19 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
 }
 
 /* The sweep. The exact reference comes first (its image is every other row's yardstick), then
- * none (the unshadowed frame every overhead is measured against). Scenes marked `papers yes` also
- * get the seed papers' settings: 4096^2 maps for the CSSM paper's Tables 3-4 (threshold, deep with
- * 3 nodes per channel, CSSM with 13 taps) and the deep-map paper's Table 1 (128^2-512^2 at
- * epsilon 0.02 and 0.06 with the 5-tap pre-filter); the other scenes stop at 2048^2, because one
- * 4096^2 deep map takes minutes to build on a 2-core CPU. */
+ * none (the unshadowed frame every overhead is measured against). Maps are 512^2 and 1024^2 (the
+ * headline size); a scene marked `papers cssm` adds 2048^2 and 4096^2 for the CSSM paper's
+ * Tables 3-4 (threshold, deep with 3 nodes per channel, CSSM with 13 taps; unbounded deep maps up
+ * to 2048^2), one marked `papers deep` the deep-map paper's Table 1 (128^2-512^2 at epsilon 0.02
+ * and 0.06 with the 5-tap pre-filter). On a 2-core CPU one 4096^2 build takes one to three
+ * minutes, so the large maps are measured where the papers' tables need them. */
 static void build_configs(int quick, int papers, uint32_t max_map, float exact_step,
                           config_list *L)
 {
     static const uint32_t maps_full[] = {512, 1024, 2048, 4096};
     static const uint32_t maps_quick[] = {512};
     const uint32_t *maps = quick ? maps_quick : maps_full;
-    size_t nmaps = quick ? 1 : (papers ? 4 : 3);
+    size_t nmaps = quick ? 1 : (papers & SCENE_PAPERS_CSSM) ? 4 : 2;
     L->count = 0;
     L->headline_map = quick ? 512 : 1024;
     add_reference(L, exact_step, 1);
@@ -239,7 +242,7 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
         add_deep(L, 1024, 0.06f, 0, 1);
         add_deep(L, 1024, 0.1f, 0, 1);
     }
-    if (!quick && papers) {
+    if (!quick && (papers & SCENE_PAPERS_DEEP)) {
         add_deep(L, 1024, 0.02f, 0, 5);
         static const uint32_t small[] = {128, 256, 512};
         for (size_t i = 0; i < 3; ++i) {
@@ -266,7 +269,7 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
     }
 }
 
-/* ---- results ----------------------------------------------------------------------------------- */
+/* ---- results --------------------------------------------------------------------------------- */
 
 typedef struct result {
     int scene;               /* index into the scene list */
@@ -355,7 +358,7 @@ static result *new_result(bench_run *B)
     return r;
 }
 
-/* ---- small helpers ------------------------------------------------------------------------------ */
+/* ---- small helpers --------------------------------------------------------------------------- */
 
 static int mkdirs(const char *path)
 {
@@ -428,7 +431,7 @@ static void progress(bench_run *B, const char *scene, const config *c)
             c->label, e, rem);
 }
 
-/* ---- the machine ----------------------------------------------------------------------------------- */
+/* ---- the machine ----------------------------------------------------------------------------- */
 
 static void read_loadavg(double out[3])
 {
@@ -499,7 +502,7 @@ static void write_machine(bench_run *B, FILE *f)
             B->o.warmup, B->o.warmup == 1 ? "" : "s");
 }
 
-/* ---- rendering and measuring ------------------------------------------------------------------------- */
+/* ---- rendering and measuring ----------------------------------------------------------------- */
 
 typedef struct scene_ctx {
     umbra_scene scene;
@@ -560,7 +563,7 @@ static outcome measure(bench_run *B, scene_ctx *S, const char *scene, const conf
     double slow = B->o.quick ? SLOW_MS / 2.0 : SLOW_MS;
     double very_slow = B->o.quick ? VERY_SLOW_MS / 2.0 : VERY_SLOW_MS;
     if (t0 > very_slow) {
-        runs = 0;
+        runs = 1;
         warmup = 0;
     } else if (t0 > slow) {
         runs = runs < 2 ? runs : 2;
@@ -876,7 +879,7 @@ done:
     scene_ctx_release(&S);
 }
 
-/* ---- Pareto fronts -------------------------------------------------------------------------------- */
+/* ---- Pareto fronts --------------------------------------------------------------------------- */
 
 typedef struct front_point {
     double cost, rmse;
@@ -905,7 +908,8 @@ static void pareto(bench_run *B)
             int n = 0;
             for (int k = 0; k < B->result_count; ++k) {
                 const result *r = &B->results[k];
-                if (r->scene == si && !r->cfg.exact && r->err.rmse > 0.0 && (!mem || r->memory > 0)) {
+                if (r->scene == si && !r->cfg.exact && r->err.rmse > 0.0 &&
+                    (!mem || r->memory > 0)) {
                     pts[n].cost = mem ? (double)r->memory : r->total_ms;
                     pts[n].rmse = r->err.rmse;
                     pts[n].row = k;
@@ -946,7 +950,7 @@ static void pareto(bench_run *B)
     free(pts);
 }
 
-/* ---- output: CSV ---------------------------------------------------------------------------------- */
+/* ---- output: CSV ----------------------------------------------------------------------------- */
 
 /* Columns of accuracy.csv, in order; plot_accuracy.gp gets the indices it needs from here. */
 static const char *const csv_columns[] = {
@@ -1009,7 +1013,7 @@ static void write_csv(bench_run *B)
     fclose(f);
 }
 
-/* ---- output: plots -------------------------------------------------------------------------------- */
+/* ---- output: plots --------------------------------------------------------------------------- */
 
 static const umbra_shadow_technique plot_order[] = {
     UMBRA_SHADOW_NONE, UMBRA_SHADOW_REFERENCE, UMBRA_SHADOW_THRESHOLD,
@@ -1106,7 +1110,7 @@ static void write_plots(bench_run *B)
     }
 }
 
-/* ---- output: Markdown ------------------------------------------------------------------------------- */
+/* ---- output: Markdown ------------------------------------------------------------------------ */
 
 static const result *find_headline(const bench_run *B, int si, int h)
 {
@@ -1204,8 +1208,8 @@ static void headline_table(const bench_run *B, FILE *f, int si)
         if (h == H_NONE)
             snprintf(name, sizeof name, "none (unshadowed)");
         else
-            snprintf(name, sizeof name, "%s, %s", umbra_shadow_technique_name(any->cfg.desc.technique),
-                     any->cfg.label);
+            snprintf(name, sizeof name, "%s, %s",
+                     umbra_shadow_technique_name(any->cfg.desc.technique), any->cfg.label);
         fprintf(f, "| %s | %s | %s | %.4f | %.4f | %s | %s |", name, o, b, rm / n, ss / n, m, sp);
         if (si < 0)
             fprintf(f, " %d |", n);
@@ -1245,7 +1249,8 @@ static void write_headline(bench_run *B)
         headline_table(B, f, ms);
     }
     fprintf(f, "\n**All %d scenes** (%s): ratios, memory and speed-ups are geometric means, RMSE "
-               "and SSIM arithmetic means over the scenes where the setting ran:\n\n", nscenes, names);
+               "and SSIM arithmetic means over the scenes where the setting ran:\n\n",
+            nscenes, names);
     headline_table(B, f, -1);
     fprintf(f, "\nRender overhead: render time with shadows over the unshadowed render of the same "
                "view; build: the shadow structure's construction over one unshadowed frame (paid "
@@ -1338,7 +1343,7 @@ static void write_summary(bench_run *B)
     fclose(f);
 }
 
-/* ---- output: the papers' tables ------------------------------------------------------------------------ */
+/* ---- output: the papers' tables -------------------------------------------------------------- */
 
 static const result *find_run(const bench_run *B, int si, umbra_shadow_technique t,
                               uint32_t map, uint32_t taps, float eps, uint32_t nodes,
@@ -1453,28 +1458,41 @@ static void write_papers(bench_run *B)
                "Generation (shadow-map build) and rendering times at 1024², 2048² and 4096² for "
                "the opacity-threshold map (opacity 0.5), the deep shadow map with 3 nodes per "
                "colour channel and CSSM with 13 taps. The paper's numbers are averages over "
-               "several data sets on its GPU; ours are medians per scene, averaged over the "
-               "scenes below (and shown for the walnut, the paper's Figure 3 data set). "
+               "several data sets on its GPU; ours are medians on the scenes marked `papers "
+               "cssm` (the walnut: the paper's Figure 3 data set), averaged if several. "
                "Ratios: each technique over the threshold map at the same size, and each size "
                "over 1024² for the same technique.\n\n");
     int n = 0;
     double ours[3][3];
     if (cssm_tables_mean(B, -1, 0, ours, &n)) {
         char whose[128];
-        snprintf(whose, sizeof whose, "ours: mean over %d scene%s", n, n == 1 ? "" : "s");
+        char names[256] = "";
+        for (int si = 0, k = 0; si < B->scene_count; ++si) {
+            double dummy[3][3];
+            int one = 0;
+            if (cssm_tables_mean(B, si, 0, dummy, &one)) {
+                size_t len = strlen(names);
+                snprintf(names + len, sizeof names - len, "%s%s", k++ ? ", " : "",
+                         B->scenes[si].name);
+            }
+        }
+        if (n == 1)
+            snprintf(whose, sizeof whose, "ours: %s", names);
+        else
+            snprintf(whose, sizeof whose, "ours: mean over %s", names);
         cssm_table(f, "**Table 3, generation**", paper_gen, ours, whose);
         cssm_tables_mean(B, -1, 1, ours, &n);
         cssm_table(f, "**Table 4, rendering**", paper_ren, ours, whose);
-        int w = scene_index(B, "walnut");
-        if (w >= 0 && cssm_tables_mean(B, w, 0, ours, &n)) {
+        int w = scene_index(B, "walnut"), nw = 0;
+        if (n > 1 && w >= 0 && cssm_tables_mean(B, w, 0, ours, &nw)) {
             cssm_table(f, "**Table 3, generation**", paper_gen, ours, "ours: walnut");
-            cssm_tables_mean(B, w, 1, ours, &n);
+            cssm_tables_mean(B, w, 1, ours, &nw);
             cssm_table(f, "**Table 4, rendering**", paper_ren, ours, "ours: walnut");
         }
     } else {
         fprintf(f, "Not measured in this run: it needs threshold, deep (3 nodes) and CSSM at "
-                   "1024², 2048² and 4096² (the full sweep; `--quick` and `--max-map` below 4096 "
-                   "leave them out).\n\n");
+                   "1024², 2048² and 4096² (the full sweep on a scene marked `papers cssm`; "
+                   "`--quick` and `--max-map` below 4096 leave them out).\n\n");
     }
 
     /* Deep-map paper (Hadwiger et al.), Table 1: construction speed in fps for 128^2..512^2 maps
@@ -1538,7 +1556,7 @@ static void write_papers(bench_run *B)
     fclose(f);
 }
 
-/* ---- options and the main loop ---------------------------------------------------------------------------- */
+/* ---- options and the main loop --------------------------------------------------------------- */
 
 static void usage(FILE *f)
 {
@@ -1554,7 +1572,7 @@ static void usage(FILE *f)
         "  --out DIR        output directory (default: <source>/bench/results/accuracy, or\n"
         "                   accuracy-quick/ next to umbra-bench with --quick)\n"
         "  --runs N         timed runs per setting (default 3); fewer for settings\n"
-        "                   whose first frame takes over %.0f s (2) or %.0f s (0: first frame);\n"
+        "                   whose first frame takes over %.0f s (2) or %.0f s (1);\n"
         "                   half those with --quick\n"
         "  --warmup N       warm-up frames per setting, the first one included (default 1)\n"
         "  --max-map N      leave out light-space maps larger than N^2 (default 4096)\n"

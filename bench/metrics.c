@@ -126,7 +126,8 @@ int metrics_compare(const float *a, const float *b, uint32_t w, uint32_t h, metr
     double sq = 0.0, abs_sum = 0.0, max_abs = 0.0;
     for (size_t i = 0; i < px; ++i)
         for (int c = 0; c < 3; ++c) {
-            double d = (double)metrics_display(a[4 * i + c]) - (double)metrics_display(b[4 * i + c]);
+            double d =
+                (double)metrics_display(a[4 * i + c]) - (double)metrics_display(b[4 * i + c]);
             double ad = fabs(d);
             sq += d * d;
             abs_sum += ad;

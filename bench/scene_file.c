@@ -281,13 +281,14 @@ static int parse_line(parser *p, char **tok, int ntok, const char *dir, const ch
     if (strcmp(key, "volume") == 0) {
         if (ntok >= 2 && strcmp(tok[1], "builtin") == 0) {
             if (ntok < 3 || ntok > 4)
-                return parse_error(p, "'volume builtin' takes a scene name and an optional resolution");
+                return parse_error(p, "'volume builtin' takes a scene name and an optional "
+                                      "resolution");
             int known = 0;
             for (const char *const *n = umbra_scene_names(); *n; ++n)
                 known |= strcmp(*n, tok[2]) == 0;
             if (!known)
-                return parse_error(p, "'volume builtin': no built-in scene '%s' (known: spheres, slab, "
-                               "marschner-lobb)", tok[2]);
+                return parse_error(p, "'volume builtin': no built-in scene '%s' (known: "
+                                      "spheres, slab, marschner-lobb)", tok[2]);
             s->builtin = 1;
             snprintf(s->volume, sizeof s->volume, "%s", tok[2]);
             if (ntok == 4 && (!parse_uint(tok[3], &s->builtin_resolution) ||
@@ -358,9 +359,18 @@ static int parse_line(parser *p, char **tok, int ntok, const char *dir, const ch
         return on_off(p, key, tok, ntok, &s->ground);
     if (strcmp(key, "quick") == 0)
         return on_off(p, key, tok, ntok, &s->quick);
-    if (strcmp(key, "papers") == 0)
-        return on_off(p, key, tok, ntok, &s->papers);
-    return parse_error(p, "key '%s' has no parser", key); /* unreachable: every key is handled above */
+    if (strcmp(key, "papers") == 0) {
+        int c = ntok == 2 ? choice(tok[1], "no|cssm|deep|cssm,deep|deep,cssm") : -1;
+        if (c < 0)
+            return parse_error(p, "'papers' takes no, cssm, deep or cssm,deep");
+        static const int bits[5] = {0, SCENE_PAPERS_CSSM, SCENE_PAPERS_DEEP,
+                                    SCENE_PAPERS_CSSM | SCENE_PAPERS_DEEP,
+                                    SCENE_PAPERS_CSSM | SCENE_PAPERS_DEEP};
+        s->papers = bits[c];
+        return 0;
+    }
+    /* Unreachable: every key of the tables is handled above. */
+    return parse_error(p, "key '%s' has no parser", key);
 }
 
 int scene_parse_text(const char *text, const char *path, const char *data_dir, int hash_files,
@@ -398,7 +408,8 @@ int scene_parse_text(const char *text, const char *path, const char *data_dir, i
         /* The name becomes part of file names and of the CSV. */
         if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
               c == '_' || c == '-'))
-            return parse_error(&p, "scene name '%s' may only hold letters, digits, '_' and '-'", s->name);
+            return parse_error(&p, "scene name '%s' may only hold letters, digits, '_' and '-'",
+                               s->name);
     }
 
     const char *line = text;
@@ -418,7 +429,8 @@ int scene_parse_text(const char *text, const char *path, const char *data_dir, i
         char *q = buf;
         while (*q == ' ' || *q == '\t' || *q == '\r')
             ++q;
-        if (strncmp(q, "description", 11) == 0 && (q[11] == '\0' || q[11] == ' ' || q[11] == '\t')) {
+        if (strncmp(q, "description", 11) == 0 &&
+            (q[11] == '\0' || q[11] == ' ' || q[11] == '\t')) {
             /* Free text: keep it as written (inner blanks included), trailing blanks trimmed. */
             char *text_start = q + 11;
             while (*text_start == ' ' || *text_start == '\t')

@@ -28,8 +28,10 @@
  *   ground on | off / ground_color R G B / ground_offset F
  *   background R G B A          premultiplied
  *   quick yes | no              whether --quick includes this scene (default no)
- *   papers yes | no             whether the full sweep adds the seed papers' settings (4096^2
- *                               maps, the deep-map paper's Table 1) here (default no)
+ *   papers cssm | deep | cssm,deep | no
+ *                               the seed papers' settings the full sweep adds for this scene:
+ *                               cssm = 2048^2 and 4096^2 maps (CSSM paper, Tables 3-4), deep =
+ *                               the deep-map paper's Table 1 settings (default no)
  *
  * A built-in volume takes every item the file leaves out from the built-in scene (its camera,
  * light and options). A volume file needs tf, light and eye; what else is left out takes the
@@ -44,6 +46,8 @@
 #include "umbra/umbra.h"
 
 #define SCENE_PATH_MAX 4096
+#define SCENE_PAPERS_CSSM 1
+#define SCENE_PAPERS_DEEP 2
 #define SCENE_NAME_MAX 64
 
 typedef struct scene_spec {
@@ -73,7 +77,8 @@ typedef struct scene_spec {
     int have_kd, have_ks, have_shininess, have_ambient, have_ground_color, have_ground_offset,
         have_background;
     float kd, ks, shininess, ambient[3], ground_color[3], ground_offset, background[4];
-    int quick, papers;
+    int quick;
+    int papers;                        /* SCENE_PAPERS_* bits */
 
     uint64_t hash;                     /* FNV-1a of the scene file and its tf files' contents */
 } scene_spec;

@@ -167,7 +167,7 @@ static void test_ssim_small_image(void **state)
     assert_true(metrics_ssim(x, y, 0, 5) < -1.5);
 }
 
-/* ---- scene files ------------------------------------------------------------------------------- */
+/* ---- scene files ----------------------------------------------------------------------------- */
 
 static int parse(const char *text, scene_spec *s, char *err, size_t n)
 {
@@ -199,7 +199,8 @@ static void test_scene_parses_all_keys(void **state)
         "ambient 0.25\n"
         "ground off\n"
         "background 0.08 0.08 0.1 1\n"
-        "quick yes\n";
+        "quick yes\n"
+        "papers cssm,deep\n";
     scene_spec s;
     char err[512];
     assert_int_equal(parse(text, &s, err, sizeof err), 0);
@@ -221,6 +222,7 @@ static void test_scene_parses_all_keys(void **state)
     assert_true(s.have_ambient && s.ambient[0] == 0.25f && s.ambient[2] == 0.25f);
     assert_true(s.have_background && s.background[3] == 1.0f);
     assert_int_equal(s.quick, 1);
+    assert_int_equal(s.papers, SCENE_PAPERS_CSSM | SCENE_PAPERS_DEEP);
 
     /* The hash follows the content. */
     scene_spec t;
@@ -256,6 +258,7 @@ static void test_scene_rejects_bad_files_with_clear_messages(void **state)
         {"volume builtin slab\nground maybe\n", "'ground': 'maybe' is not one of on, off"},
         {"volume builtin slab\nsize 4 4\n", "'size' takes width and height in [8, 8192]"},
         {"volume builtin slab\ncamera orthographic\n", "needs an 'ortho_height H' line"},
+        {"volume builtin slab\npapers all\n", "'papers' takes no, cssm, deep or cssm,deep"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         scene_spec s;
