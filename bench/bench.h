@@ -26,6 +26,8 @@ typedef struct bench_command {
 } bench_command;
 
 int bench_raycast(int argc, char **argv); /* bench/raycast.c */
+int bench_convolution(int argc, char **argv); /* bench/convolution.c */
+int bench_accuracy(int argc, char **argv); /* bench/accuracy.c */
 
 /* ---- timing -------------------------------------------------------------------------------------- */
 

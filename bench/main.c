@@ -9,6 +9,10 @@
 static const bench_command commands[] = {
     {"raycast", bench_raycast,
      "view-space ray casting of the bonsai, no shadows: umbra vs the native-C twin (and VTK)"},
+    {"convolution", bench_convolution,
+     "convolution shadows (paper's Table 1): slice distance x sub-samples x pre-integration"},
+    {"accuracy", bench_accuracy,
+     "every shadow technique vs the exact reference: error, time, memory (CSV, plots)"},
 };
 
 static void usage(FILE *f)

@@ -9,11 +9,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "preintegration.h"
 #include "renderer_internal.h"
+
+extern const umbra__technique umbra__technique_threshold; /* host/shadow_maps.c */
+extern const umbra__technique umbra__technique_cssm;      /* host/shadow_maps.c */
+extern const umbra__technique umbra__technique_deep;      /* host/shadow_deep.c */
+extern const umbra__technique umbra__technique_convolution; /* host/shadow_convolution.c */
 
 static const umbra__technique *const techniques[] = {
     &umbra__technique_none,
     &umbra__technique_reference,
+    &umbra__technique_threshold,
+    &umbra__technique_cssm,
+    &umbra__technique_deep,
+    &umbra__technique_convolution,
 };
 
 static const char *const technique_names[] = {"none", "reference", "threshold", "deep", "cssm",
@@ -191,6 +201,7 @@ void umbra_renderer_release(umbra_renderer r)
         return;
     drop_technique(r);
     release_kernels(r);
+    umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_bricks_buf, &r->out_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
@@ -676,10 +687,12 @@ static umbra_status prepare_shadow(umbra_renderer r)
 static umbra_status ensure_kernels(umbra_renderer r)
 {
     char options[256];
-    const char *files[] = {"common.cl", "sampling.cl", r->tech->kernel_file, "raycast.cl"};
+    /* lightspace.cl: the map projection the light-space techniques' lookups need. */
+    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "preintegration.cl",
+                           r->tech->kernel_file, "raycast.cl"};
     cl_program program;
     umbra__build_options(r, options, sizeof options);
-    umbra_status st = umbra__program_get(r->ctx, files, 4, options, &program);
+    umbra_status st = umbra__program_get(r->ctx, files, 6, options, &program);
     if (st != UMBRA_SUCCESS || program == r->program)
         return st;
     release_kernels(r);
@@ -733,6 +746,19 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         goto fail;
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &out));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->samples_buf));
+    /* Pre-integrated ray casting (desc->preintegrated): the view table for the view step; any
+     * buffer stands in for it when the mode is off (table size 0). */
+    cl_mem preint = r->view_tf_buf;
+    cl_uint preint_size = 0;
+    if (r->shadow.preintegrated) {
+        st = umbra__preint_ensure(ctx, fn, &r->preint, r->tf, r->opts.step, UMBRA__PREINT_VIEW, 0,
+                                  &preint, NULL);
+        if (st != UMBRA_SUCCESS)
+            goto fail;
+        preint_size = UMBRA__PREINT_SIZE;
+    }
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &preint));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof preint_size, &preint_size));
     if (r->tech->bind && (st = r->tech->bind(r, r->render_kernel, next)) != UMBRA_SUCCESS)
         goto fail;
     size_t global[2] = {width, height};

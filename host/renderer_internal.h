@@ -74,6 +74,7 @@ struct umbra_renderer_t {
     size_t out_bytes;
     cl_program program;                      /* the ray caster + technique program in use */
     cl_kernel render_kernel, query_kernel;
+    struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
 
     umbra_render_stats stats;
 };

@@ -81,3 +81,56 @@ inline float ls_depth(__global const UmbraShadow *S, float3 o, float t)
     float along = S->ls_mode == UMBRA_LS_ORTHO ? dot(o, F3(S->ls_w)) + t : t;
     return (along - S->near_far[0]) * S->near_far[2];
 }
+
+/* ---- filtered map lookups (threshold and CSSM) -------------------------------------------------
+ * A lookup reads m texels around the sample's texel at these offsets and averages the m binary
+ * tests (the CSSM paper's Table 2; the threshold map uses the same sets, so softness compares
+ * fairly). The first m entries form the set for m = 1, 7, 13, 21:
+ *   13: the paper's {(0,0), (+-3,+-3), (+-4,0), (0,+-4), (+-7,0), (0,+-7)};
+ *    7: its seven smallest: (0,0), the four axis taps at radius 4 and, of the four diagonals at
+ *       radius 4.24, the point-symmetric pair (3,3), (-3,-3), so the set stays centred on the
+ *       sample (no shift of the shadow): which pair is a free choice, the paper does not say;
+ *   21: the 13 plus eight larger: (+-5,+-5) (radius 7.07) completing the ring at radius 7 and
+ *       (+-10,0), (0,+-10), a ring at radius 10. */
+#define LS_MAX_TAPS 21
+/* The stored depth of a texel whose ray is never stopped. Not 1: points beyond the box's far
+ * extent (the ground plane) have depths above 1 and must still count as lit there. */
+#define LS_DEPTH_NEVER FLT_MAX
+__constant int2 ls_taps[LS_MAX_TAPS] = {
+    (int2)(0, 0),   (int2)(4, 0),   (int2)(-4, 0),  (int2)(0, 4),   (int2)(0, -4),
+    (int2)(3, 3),   (int2)(-3, -3), (int2)(3, -3),  (int2)(-3, 3),  (int2)(7, 0),
+    (int2)(-7, 0),  (int2)(0, 7),   (int2)(0, -7),  (int2)(5, 5),   (int2)(-5, -5),
+    (int2)(5, -5),  (int2)(-5, 5),  (int2)(10, 0),  (int2)(-10, 0), (int2)(0, 10),
+    (int2)(0, -10)};
+
+/* The sample's texel, or false where the map position is not finite or far outside the map
+ * (behind a perspective light, for instance): such a point is not covered and counts as lit. */
+inline bool ls_base_texel(__global const UmbraShadow *S, float2 xy, int2 *texel)
+{
+    const float lim = 2.0f * (float)S->map_size + 64.0f;
+    if (!(fabs(xy.x) < lim && fabs(xy.y) < lim))
+        return false;
+    *texel = convert_int2(floor(xy));
+    return true;
+}
+
+/* Index of texel t in the map, or -1 outside it. An octahedral map covers every direction and its
+ * border folds onto itself (the octahedron's lower faces meet there), so a tap that crosses the
+ * border continues mirrored on the other side of the edge's midpoint; elsewhere outside is -1. */
+inline int ls_texel_index(__global const UmbraShadow *S, int2 t)
+{
+    const int n = (int)S->map_size;
+    if (S->ls_mode == UMBRA_LS_OCTAHEDRAL) {
+        if (t.x < 0 || t.x >= n) {
+            t.x = t.x < 0 ? -1 - t.x : 2 * n - 1 - t.x;
+            t.y = n - 1 - t.y;
+        }
+        if (t.y < 0 || t.y >= n) {
+            t.y = t.y < 0 ? -1 - t.y : 2 * n - 1 - t.y;
+            t.x = n - 1 - t.x;
+        }
+    }
+    if (t.x < 0 || t.y < 0 || t.x >= n || t.y >= n)
+        return -1;
+    return t.y * n + t.x;
+}

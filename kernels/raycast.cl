@@ -53,7 +53,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const float4 *view_tf, __global const float4 *light_tf,
                              __global const uchar *view_bricks, __global const uchar *light_bricks,
                              __global const UmbraShadow *S, __global float4 *out,
-                             __global UMBRA_COUNT_T *samples SHADOW_KERNEL_PARAMS)
+                             __global UMBRA_COUNT_T *samples, __global const float4 *preint,
+                             uint preint_size SHADOW_KERNEL_PARAMS)
 {
     const int px = get_global_id(0), py = get_global_id(1);
     if (px >= (int)F->width || py >= (int)F->height)
@@ -86,15 +87,41 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         const float jitter = (flags & UMBRA_FLAG_JITTER) ? umbra_random(F->seed, px, py, 0u) : 0.0f;
         const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         const int n = (int)ceil((t1 - t0) / h - jitter);
+        /* Pre-integrated mode (preint_size != 0, kernels/preintegration.cl): sample k stands for
+         * the segment [t, t + h], its colour and opacity from the table at (s(t), s(t + h)), its
+         * shading and shadow taken at the front. The back value is kept for the next segment. A
+         * segment is skipped only if both ends lie in empty bricks, and a skip stops one sample
+         * short so the segment entering a visible brick is kept. */
+        int k_back = -1;
+        float s_back = 0.0f;
+        /* Samples before t_visible lie in a brick already found visible: the brick table is read
+         * once per brick crossed, not once per sample (per-sample lookups cost more than the
+         * trilinear fetch on CPUs). */
+        float t_visible = -UMBRA_INF;
         for (int k = 0; k < n;) {
             float t = t0 + ((float)k + jitter) * h;
             float3 p = o + t * d;
-            if (skip && !view_bricks[brick_index(g, p)]) {
-                k = next_sample_after(t0, h, jitter, brick_exit(g, o, d, t), k);
-                continue;
+            if (skip && t >= t_visible) {
+                float t_exit = brick_exit(g, o, d, t);
+                if (view_bricks[brick_index(g, p)]) {
+                    t_visible = t_exit;
+                } else if (!(preint_size && view_bricks[brick_index(g, p + h * d)])) {
+                    int next = next_sample_after(t0, h, jitter, t_exit, k);
+                    k = preint_size ? max(next - 1, k + 1) : next;
+                    continue;
+                }
             }
             ++taken;
-            float4 c = tf_lookup(view_tf, F->tf_size, sample_volume(vol, g, p));
+            float4 c;
+            if (preint_size) {
+                float sf = k == k_back ? s_back : sample_volume(vol, g, p);
+                s_back = sample_volume(vol, g, p + h * d);
+                k_back = k + 1;
+                c = preint_lookup(preint, preint_size, sf, s_back);
+                c.xyz = preint_color(c);
+            } else {
+                c = tf_lookup(view_tf, F->tf_size, sample_volume(vol, g, p));
+            }
             if (c.w > 0.0f) {
                 float3 s = SHADOW_FACTOR(sr, p);
                 float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p)

@@ -37,12 +37,19 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     int n_full = (int)floor(len / h);
     float last = len - (float)n_full * h;
     light_t T = (light_t)(1.0f);
+    /* Samples before t_visible lie in a brick already found visible: the brick table is read
+     * once per brick crossed, not once per sample. */
+    float t_visible = -UMBRA_INF;
     for (int k = 0; k < n_full;) {
         float t = t_start + ((float)k + 0.5f) * h;
         float3 q = p + t * d;
-        if (skip && !light_bricks[brick_index(g, q)]) {
-            k = next_sample_after(t_start, h, 0.5f, brick_exit(g, p, d, t), k);
-            continue;
+        if (skip && t >= t_visible) {
+            float t_exit = brick_exit(g, p, d, t);
+            if (!light_bricks[brick_index(g, q)]) {
+                k = next_sample_after(t_start, h, 0.5f, t_exit, k);
+                continue;
+            }
+            t_visible = t_exit;
         }
         float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
         T *= light_pass(c, flags);

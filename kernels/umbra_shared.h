@@ -77,7 +77,10 @@ typedef struct UmbraShadow {
     uint32_t max_nodes;       /* deep map: node budget per channel (0 = unbounded) */
     uint32_t seed;            /* CSSM */
     uint32_t ls_mode;         /* UMBRA_LS_* */
-    uint32_t pad[13];         /* room for technique fields without changing the size */
+    float depth_bias;         /* threshold / CSSM: normalised depth a sample must lie beyond a
+                                 stored depth to be shadowed by it */
+    uint32_t deep_tile;       /* deep map: tile edge in texels (16, or 8 on small work-groups) */
+    uint32_t pad[11];         /* room for technique fields without changing the size */
 } UmbraShadow;
 
 #endif

@@ -109,19 +109,41 @@ typedef struct umbra_shadow_desc {
     /* light-space maps */
     uint32_t map_size;           /* map resolution, map_size^2 texels (default 1024) */
     float map_step;              /* light-ray step in voxels (default 0.5) */
-    float threshold;             /* threshold map: accumulated opacity (default 0.5) */
-    uint32_t taps;               /* CSSM / filtered threshold: 1, 7, 13 or 21 (default 13) */
-    float epsilon;               /* deep map: compression error bound (default 0.02) */
-    uint32_t max_nodes;          /* deep map: fixed node budget per channel, 0 = unbounded */
-    uint32_t block_size;         /* deep map: node layers per block (default 8) */
+    float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
+                                    a texel's depth is stored (default 0.5); one grey depth per
+                                    texel, map_size^2 * 4 bytes */
+    uint32_t taps;               /* CSSM / filtered threshold: texels averaged per lookup, 1, 7,
+                                    13 (the paper's set) or 21 (default 13); the offsets are
+                                    listed in kernels/lightspace.cl */
+    float epsilon;               /* deep map: compression error bound in [0, 1] (default 0.02) */
+    uint32_t max_nodes;          /* deep map: fixed budget of nodes per texel, 0 (unbounded) or
+                                    2..64; a node holds a depth and every channel's visibility
+                                    (4 floats for coloured light: 3 nodes = 12 values) */
+    uint32_t block_size;         /* deep map: node layers per block, 1..256 (default 8) */
     uint32_t prefilter;          /* deep map: sub-pixel rays per texel, 1 or 5 (default 1) */
     int lookup_table;            /* deep map: use the pre-compressed segment table (default 1) */
-    uint32_t seed;               /* CSSM random stream (default 1) */
-    /* convolution */
-    float slice_distance;        /* voxels (default 0.5) */
-    uint32_t subsamples;         /* SCS sub-samples between slices (default 0) */
-    int preintegrated;           /* nonzero: pre-integrated attenuation (default 0) */
-    float cone_angle_degrees;    /* convolution kernel half-angle (default 5) */
+    uint32_t seed;               /* CSSM: seed of the counter-based random numbers (default 1):
+                                    the same seed gives the same map and image, bit for bit, on
+                                    the same device. The map holds one depth per simulated light
+                                    channel (3, or 1 for a grey light): map_size^2 * 12 or 4
+                                    bytes */
+    /* convolution: the technique renders the frame itself with view-aligned slices (ICS). The
+     * light must come from the viewer's side: a directional light within 80 degrees of the view
+     * direction, a point light from which every corner of the box lies within 80 degrees of it;
+     * others give UMBRA_ERROR_UNSUPPORTED. The view step and jitter are not used (the slices
+     * set the sampling); the ground plane is supported. */
+    float slice_distance;        /* voxels between slices, [0.02, 16] (default 0.5) */
+    uint32_t subsamples;         /* SCS: volume samples between two slices, 0..64 (default 0);
+                                    the volume is sampled every slice_distance/(subsamples+1)
+                                    and the light interpolated between the two slices */
+    int preintegrated;           /* nonzero: pre-integrated segments (a 2D table over front and
+                                    back value, rebuilt when the transfer function or the
+                                    segment length changes); for the convolution technique the
+                                    light is attenuated with the segment's pre-integrated
+                                    transmittance, for every ray-cast technique the view ray's
+                                    segments of length `step` are pre-integrated (default 0) */
+    float cone_angle_degrees;    /* half-angle of the cone the convolution kernel spreads the
+                                    light over per slice, [0, 60] (default 5; 0: no blur) */
 } umbra_shadow_desc;
 
 void umbra_shadow_desc_init(umbra_shadow_desc *desc);
@@ -164,7 +186,8 @@ typedef struct umbra_render_stats {
     int shadow_rebuilt;          /* nonzero if the last render rebuilt the shadow structure */
     size_t shadow_memory_bytes;  /* device memory the shadow structure holds */
     uint32_t light_channels;     /* 1 or 3: light channels the technique simulates */
-    uint32_t slices;             /* convolution: slices in the last frame, else 0 */
+    uint32_t slices;             /* convolution: slices in the last frame (each one kernel
+                                    launch), else 0 */
     uint64_t samples;            /* view samples taken in the last render (skipped ones excluded) */
 } umbra_render_stats;
 

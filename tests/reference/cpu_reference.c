@@ -237,12 +237,17 @@ static v3 shadow(const prep *P, v3 p)
     float last = len - (float)n_full * h;
     float T[3] = {1, 1, 1}, c[4], f[3];
     int skip = P->s->opts.empty_space_skipping, b[3];
+    float t_visible = -INFINITY;
     for (int k = 0; k < n_full;) {
         float t = t_start + ((float)k + 0.5f) * h;
         v3 q = add(p, mul(d, t));
-        if (skip && !P->light_bricks[brick_of(P, q, b)]) {
-            k = next_after(t_start, h, 0.5f, brick_exit(P, p, d, t), k);
-            continue;
+        if (skip && t >= t_visible) {
+            float t_exit = brick_exit(P, p, d, t);
+            if (!P->light_bricks[brick_of(P, q, b)]) {
+                k = next_after(t_start, h, 0.5f, t_exit, k);
+                continue;
+            }
+            t_visible = t_exit; /* the brick table is read once per brick crossed */
         }
         lookup(P->light_tf, P->light_n, sample(P, q), c);
         pass(P, c, f);
@@ -348,12 +353,17 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             const float hstep = P->step;
             float jitter = o->jitter ? random01(o->seed, (uint32_t)px, (uint32_t)py, 0u) : 0.0f;
             int n = (int)ceilf((t1 - t0) / hstep - jitter), b[3];
+            float t_visible = -INFINITY; /* samples before it lie in a brick found visible */
             for (int k = 0; k < n;) {
                 float t = t0 + ((float)k + jitter) * hstep;
                 v3 p = add(org, mul(d, t));
-                if (o->empty_space_skipping && !P->view_bricks[brick_of(P, p, b)]) {
-                    k = next_after(t0, hstep, jitter, brick_exit(P, org, d, t), k);
-                    continue;
+                if (o->empty_space_skipping && t >= t_visible) {
+                    float t_exit = brick_exit(P, org, d, t);
+                    if (!P->view_bricks[brick_of(P, p, b)]) {
+                        k = next_after(t0, hstep, jitter, t_exit, k);
+                        continue;
+                    }
+                    t_visible = t_exit;
                 }
                 ++taken;
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
