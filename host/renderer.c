@@ -900,7 +900,9 @@ umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_get_stats: out is NULL");
     *out = r->stats;
-    out->light_channels = r->tech->id == UMBRA_SHADOW_NONE ? 0 : r->channels;
+    out->light_channels = r->tech->id == UMBRA_SHADOW_NONE ? 0
+                          : r->tech->channels               ? r->tech->channels
+                                                            : r->channels;
     out->shadow_memory_bytes = r->tech->memory ? r->tech->memory(r) : 0;
     return UMBRA_SUCCESS;
 }

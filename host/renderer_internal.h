@@ -31,6 +31,10 @@ typedef struct umbra__technique {
     /* Renders the whole frame into out instead of the ray caster (optional). */
     umbra_status (*render)(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out,
                            double *ms);
+    /* Light channels the technique simulates whatever the transmission: 1 for a technique that
+     * can only carry grey light (the threshold map's binary depth test); 0 means the renderer's
+     * r->channels (3 in coloured mode, 1 when the light is grey). */
+    uint32_t channels;
     /* Device bytes held by the shadow structure (optional: 0). */
     size_t (*memory)(umbra_renderer r);
     /* Frees r->tech_state (optional). */

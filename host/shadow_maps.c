@@ -201,6 +201,7 @@ const umbra__technique umbra__technique_threshold = {
     .validate = threshold_validate,
     .build = threshold_build,
     .bind = map_bind,
+    .channels = 1, /* one depth, a binary test: grey light only */
     .memory = map_memory,
     .destroy = map_destroy,
 };

@@ -274,6 +274,7 @@ static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_des
     assert_int_equal(st.shadow_rebuilt, 1);
     assert_true(st.shadow_build_ms > 0.0);
     assert_int_equal(st.shadow_memory_bytes, texels * values_colored * 4);
+    assert_int_equal(st.light_channels, values_colored); /* one value per simulated channel */
 
     umbra_camera cam = scene.camera;
     cam.eye[0] += 10.0f;
