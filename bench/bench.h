@@ -28,6 +28,7 @@ typedef struct bench_command {
 int bench_raycast(int argc, char **argv); /* bench/raycast.c */
 int bench_convolution(int argc, char **argv); /* bench/convolution.c */
 int bench_accuracy(int argc, char **argv); /* bench/accuracy.c */
+int bench_readme(int argc, char **argv);   /* bench/readme.c */
 
 /* ---- timing -------------------------------------------------------------------------------------- */
 

@@ -13,6 +13,8 @@ static const bench_command commands[] = {
      "convolution shadows (paper's Table 1): slice distance x sub-samples x pre-integration"},
     {"accuracy", bench_accuracy,
      "every shadow technique vs the exact reference: error, time, memory (CSV, plots)"},
+    {"readme", bench_readme,
+     "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
 };
 
 static void usage(FILE *f)

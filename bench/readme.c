@@ -1,0 +1,423 @@
+/* bench/readme.c: `umbra-bench readme`, which writes the README's measured sections from the
+ * recorded results, so that no figure in the README is typed by hand.
+ *
+ * The README marks each generated block with a pair of HTML comments:
+ *
+ *     <!-- umbra-bench readme: NAME -->
+ *     ... replaced on every run ...
+ *     <!-- umbra-bench readme: end -->
+ *
+ * NAME is one of:
+ *   headline  the headline table of `umbra-bench accuracy` (DIR/headline.md, itself generated
+ *             from accuracy.csv) and the main scene's error-versus-time and error-versus-memory
+ *             plots;
+ *   gallery   the main scene's pictures from the same run (DIR/images/SCENE/, written by
+ *             `--images headline`), one table row each with the build time, render time, memory,
+ *             light channels and error read from accuracy.csv.
+ * Links are written relative to the README's folder. `--check` changes nothing and exits 1 when
+ * the README is out of date (for a pre-commit check). */
+#define _XOPEN_SOURCE 700
+
+#include <errno.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench.h"
+
+#ifndef UMBRA_SOURCE_DIR
+#define UMBRA_SOURCE_DIR "."
+#endif
+
+#define MARK_BEGIN "<!-- umbra-bench readme: "
+#define MARK_END "<!-- umbra-bench readme: end -->"
+#define MAX_COLUMNS 64
+
+/* A growing string. */
+typedef struct text {
+    char *s;
+    size_t len, cap;
+} text;
+
+static int text_add(text *t, const char *s, size_t n)
+{
+    if (t->len + n + 1 > t->cap) {
+        size_t cap = t->cap ? t->cap : 4096;
+        while (cap < t->len + n + 1)
+            cap *= 2;
+        char *p = realloc(t->s, cap);
+        if (!p)
+            return -1;
+        t->s = p;
+        t->cap = cap;
+    }
+    memcpy(t->s + t->len, s, n);
+    t->len += n;
+    t->s[t->len] = '\0';
+    return 0;
+}
+
+static int text_printf(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static int text_printf(text *t, const char *fmt, ...)
+{
+    char buf[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= sizeof buf)
+        return -1;
+    return text_add(t, buf, (size_t)n);
+}
+
+/* The whole file, or NULL (errno set). */
+static char *read_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    text t = {0};
+    char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        if (text_add(&t, buf, n) != 0) {
+            free(t.s);
+            fclose(f);
+            errno = ENOMEM;
+            return NULL;
+        }
+    fclose(f);
+    if (!t.s)
+        text_add(&t, "", 0);
+    return t.s;
+}
+
+static int file_exists(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f)
+        fclose(f);
+    return f != NULL;
+}
+
+/* The file name `umbra-bench accuracy` gives a setting's picture: "<technique>-<params>" (or the
+ * technique alone when params is "-") with every character outside [A-Za-z0-9._-] made '_'. */
+static void image_name(const char *technique, const char *params, char *out, size_t size)
+{
+    if (strcmp(params, "-") == 0)
+        snprintf(out, size, "%s", technique);
+    else
+        snprintf(out, size, "%s-%s", technique, params);
+    for (char *s = out; *s; ++s)
+        if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') ||
+              *s == '-' || *s == '.' || *s == '_'))
+            *s = '_';
+}
+
+static void format_bytes(double b, char *out, size_t size)
+{
+    if (b <= 0.0)
+        snprintf(out, size, "0");
+    else if (b >= 1024.0 * 1024.0 * 1024.0)
+        snprintf(out, size, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
+    else if (b >= 1024.0 * 1024.0)
+        snprintf(out, size, "%.1f MiB", b / (1024.0 * 1024.0));
+    else if (b >= 1024.0)
+        snprintf(out, size, "%.1f KiB", b / 1024.0);
+    else
+        snprintf(out, size, "%.0f B", b);
+}
+
+static void format_ms(double ms, char *out, size_t size)
+{
+    if (!(ms > 0.0))
+        snprintf(out, size, "–");
+    else if (ms >= 100.0)
+        snprintf(out, size, "%.0f", ms);
+    else if (ms >= 10.0)
+        snprintf(out, size, "%.1f", ms);
+    else
+        snprintf(out, size, "%.2f", ms);
+}
+
+/* Splits a CSV line (no quoting: accuracy.csv has none) in place; returns the field count. */
+static int split_csv(char *line, char **fields, int max)
+{
+    int n = 0;
+    line[strcspn(line, "\r\n")] = '\0';
+    for (char *p = line; n < max;) {
+        fields[n++] = p;
+        char *comma = strchr(p, ',');
+        if (!comma)
+            break;
+        *comma = '\0';
+        p = comma + 1;
+    }
+    return n;
+}
+
+static int column(char **header, int n, const char *name)
+{
+    for (int i = 0; i < n; ++i)
+        if (strcmp(header[i], name) == 0)
+            return i;
+    return -1;
+}
+
+/* ---- the blocks ------------------------------------------------------------------------------ */
+
+typedef struct job {
+    const char *readme;
+    char results[PATH_MAX]; /* the accuracy results folder */
+    char link[PATH_MAX];    /* the same folder as the README links it */
+    const char *scene;
+} job;
+
+static int block_headline(const job *J, text *out)
+{
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/headline.md", J->results);
+    char *md = read_file(path);
+    if (!md) {
+        fprintf(stderr, "readme: cannot read %s: %s (run `umbra-bench accuracy` first)\n", path,
+                strerror(errno));
+        return -1;
+    }
+    int rc = 0;
+    for (char *line = md; *line && rc == 0;) {
+        size_t n = strcspn(line, "\n");
+        if (strncmp(line, "<!--", 4) != 0)
+            rc = text_add(out, line, n) || text_add(out, "\n", 1);
+        line += n + (line[n] == '\n');
+    }
+    free(md);
+    const char *kinds[] = {"time", "memory"};
+    int plots = 0;
+    for (int i = 0; i < 2 && rc == 0; ++i) {
+        snprintf(path, sizeof path, "%s/plots/%s-error-vs-%s.png", J->results, J->scene,
+                 kinds[i]);
+        if (!file_exists(path))
+            continue;
+        rc = text_printf(out, "%s![%s: error against %s](%s/plots/%s-error-vs-%s.png)",
+                         plots++ ? " " : "\n", J->scene, kinds[i], J->link, J->scene, kinds[i]);
+    }
+    if (plots && rc == 0)
+        rc = text_add(out, "\n", 1);
+    return rc;
+}
+
+static int block_gallery(const job *J, text *out)
+{
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/accuracy.csv", J->results);
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "readme: cannot read %s: %s (run `umbra-bench accuracy` first)\n", path,
+                strerror(errno));
+        return -1;
+    }
+    char header_line[4096], line[4096];
+    char *header[MAX_COLUMNS], *v[MAX_COLUMNS];
+    int nh = fgets(header_line, sizeof header_line, f) ? split_csv(header_line, header,
+                                                                    MAX_COLUMNS)
+                                                       : 0;
+    const char *names[] = {"scene",  "technique",    "label",          "params",
+                           "width",  "height",       "build_ms",       "render_ms",
+                           "memory_bytes", "light_channels", "rmse", "ssim"};
+    enum { SCENE, TECH, LABEL, PARAMS, WIDTH, HEIGHT, BUILD, RENDER, MEM, CHANNELS, RMSE, SSIM,
+           NCOL };
+    int col[NCOL];
+    for (int i = 0; i < NCOL; ++i)
+        if ((col[i] = column(header, nh, names[i])) < 0) {
+            fprintf(stderr, "readme: %s has no column '%s'\n", path, names[i]);
+            fclose(f);
+            return -1;
+        }
+    int rows = 0, rc = 0;
+    while (rc == 0 && fgets(line, sizeof line, f)) {
+        int n = split_csv(line, v, MAX_COLUMNS);
+        if (n != nh || strcmp(v[col[SCENE]], J->scene) != 0)
+            continue;
+        char name[512], image[PATH_MAX + 700];
+        image_name(v[col[TECH]], v[col[PARAMS]], name, sizeof name);
+        snprintf(image, sizeof image, "%s/images/%s/%s.png", J->results, J->scene, name);
+        if (!file_exists(image))
+            continue;
+        if (rows++ == 0)
+            rc = text_printf(out, "Pictures %sx%s; times are device times of one frame (medians), "
+                                  "from the same run as the headline table.\n\n"
+                                  "| picture | technique | setting | build ms | render ms | "
+                                  "memory | light channels | RMSE | SSIM |\n"
+                                  "|---|---|---|---:|---:|---:|---:|---:|---:|\n",
+                             v[col[WIDTH]], v[col[HEIGHT]]);
+        char build[32], render[32], mem[32];
+        format_ms(atof(v[col[BUILD]]), build, sizeof build);
+        format_ms(atof(v[col[RENDER]]), render, sizeof render);
+        format_bytes(atof(v[col[MEM]]), mem, sizeof mem);
+        const int exact = strcmp(v[col[TECH]], "reference") == 0 && atof(v[col[RMSE]]) == 0.0;
+        char label[256];
+        snprintf(label, sizeof label, "%s", v[col[LABEL]]);
+        for (char *s = label; *s; ++s)
+            if (*s == ';')
+                *s = ','; /* accuracy.csv writes the labels' commas as ';' */
+        if (rc == 0)
+            rc = text_printf(out, "| ![%s %s](%s/images/%s/%s.png) | %s%s%s | %s | %s | %s | %s "
+                                  "| %s | %s | %s |\n",
+                             v[col[TECH]], label, J->link, J->scene, name, exact ? "**" : "",
+                             v[col[TECH]], exact ? "**" : "", label, build, render, mem,
+                             v[col[CHANNELS]], exact ? "0" : v[col[RMSE]],
+                             exact ? "1" : v[col[SSIM]]);
+    }
+    fclose(f);
+    if (rc == 0 && rows == 0) {
+        fprintf(stderr, "readme: no pictures of scene '%s' under %s/images (run `umbra-bench "
+                        "accuracy --images headline`)\n", J->scene, J->results);
+        return -1;
+    }
+    return rc;
+}
+
+/* ---- the README ------------------------------------------------------------------------------ */
+
+/* Rewrites every marked block of src into out; 0, or -1 after a message. */
+static int regenerate(const job *J, const char *src, text *out)
+{
+    const char *p = src;
+    int blocks = 0;
+    for (;;) {
+        const char *begin = strstr(p, MARK_BEGIN);
+        while (begin && strncmp(begin, MARK_END, strlen(MARK_END)) == 0)
+            begin = strstr(begin + 1, MARK_BEGIN);
+        if (!begin)
+            break;
+        const char *name = begin + strlen(MARK_BEGIN);
+        const char *close = strstr(name, " -->");
+        const char *end = close ? strstr(close, MARK_END) : NULL;
+        if (!close || !end) {
+            fprintf(stderr, "readme: %s: a block opened with '%.40s' has no '%s'\n", J->readme,
+                    begin, MARK_END);
+            return -1;
+        }
+        char block[64];
+        snprintf(block, sizeof block, "%.*s", (int)(close - name), name);
+        const char *after_open = close + 4;
+        if (*after_open == '\n')
+            ++after_open;
+        if (text_add(out, p, (size_t)(after_open - p)) != 0)
+            return -1;
+        int rc;
+        if (strcmp(block, "headline") == 0)
+            rc = block_headline(J, out);
+        else if (strcmp(block, "gallery") == 0)
+            rc = block_gallery(J, out);
+        else {
+            fprintf(stderr, "readme: %s: unknown block '%s' (headline, gallery)\n", J->readme,
+                    block);
+            rc = -1;
+        }
+        if (rc != 0)
+            return -1;
+        p = end;
+        ++blocks;
+    }
+    if (blocks == 0) {
+        fprintf(stderr, "readme: %s has no '%sNAME -->' blocks\n", J->readme, MARK_BEGIN);
+        return -1;
+    }
+    return text_add(out, p, strlen(p));
+}
+
+/* J->link: J->results as seen from the README's folder (relative when it lies inside it). */
+static void link_path(job *J)
+{
+    char dir[PATH_MAX], rdir[PATH_MAX], racc[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", J->readme);
+    char *slash = strrchr(dir, '/');
+    if (slash)
+        *slash = '\0';
+    else
+        snprintf(dir, sizeof dir, ".");
+    snprintf(J->link, sizeof J->link, "%s", J->results);
+    if (!realpath(dir, rdir) || !realpath(J->results, racc))
+        return;
+    size_t n = strlen(rdir);
+    if (strncmp(racc, rdir, n) == 0 && racc[n] == '/')
+        snprintf(J->link, sizeof J->link, "%s", racc + n + 1);
+    else
+        snprintf(J->link, sizeof J->link, "%s", racc);
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
+               "[--check]\n"
+               "  rewrites the README's '" MARK_BEGIN "headline|gallery -->' blocks from the\n"
+               "  results of `umbra-bench accuracy`\n"
+               "  --readme FILE   default <source>/README.md\n"
+               "  --results DIR   default <source>/bench/results/accuracy\n"
+               "  --scene NAME    the scene of the plots and pictures (default walnut)\n"
+               "  --check         change nothing; exit 1 if the README is out of date\n");
+}
+
+int bench_readme(int argc, char **argv)
+{
+    job J;
+    memset(&J, 0, sizeof J);
+    char readme[PATH_MAX];
+    snprintf(readme, sizeof readme, "%s/README.md", UMBRA_SOURCE_DIR);
+    snprintf(J.results, sizeof J.results, "%s/bench/results/accuracy", UMBRA_SOURCE_DIR);
+    J.readme = readme;
+    J.scene = "walnut";
+    int check = 0;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--check") == 0) {
+            check = 1;
+        } else if (i + 1 < argc && strcmp(a, "--readme") == 0) {
+            J.readme = argv[++i];
+        } else if (i + 1 < argc && strcmp(a, "--results") == 0) {
+            snprintf(J.results, sizeof J.results, "%s", argv[++i]);
+        } else if (i + 1 < argc && strcmp(a, "--scene") == 0) {
+            J.scene = argv[++i];
+        } else {
+            fprintf(stderr, "readme: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return 2;
+        }
+    }
+    link_path(&J);
+    char *src = read_file(J.readme);
+    if (!src) {
+        fprintf(stderr, "readme: cannot read %s: %s\n", J.readme, strerror(errno));
+        return 1;
+    }
+    text out = {0};
+    int rc = regenerate(&J, src, &out) == 0 ? 0 : 1;
+    if (rc == 0 && strcmp(out.s, src) != 0) {
+        if (check) {
+            fprintf(stderr, "readme: %s is out of date: run umbra-bench readme\n", J.readme);
+            rc = 1;
+        } else {
+            FILE *f = fopen(J.readme, "wb");
+            if (!f || fwrite(out.s, 1, out.len, f) != out.len) {
+                fprintf(stderr, "readme: cannot write %s: %s\n", J.readme, strerror(errno));
+                rc = 1;
+            }
+            if (f && fclose(f) != 0)
+                rc = 1;
+            if (rc == 0)
+                fprintf(stderr, "readme: updated %s\n", J.readme);
+        }
+    } else if (rc == 0) {
+        fprintf(stderr, "readme: %s is up to date\n", J.readme);
+    }
+    free(out.s);
+    free(src);
+    return rc;
+}
