@@ -415,7 +415,9 @@ float umbra__voxel_world(umbra_renderer r)
     return fminf(s[0], fminf(s[1], s[2]));
 }
 
-/* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step. */
+/* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
+ * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
+ * alpha_for_length in kernels/common.cl). */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
 {
@@ -427,7 +429,8 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
     for (uint32_t i = 0; i < tf->count; ++i) {
         memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
-        t[4 * i + 3] = 1.0f - powf(1.0f - tf->rgba[4 * i + 3], step_voxels);
+        double a = tf->rgba[4 * i + 3];
+        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
     }
     release_mem(buf);
     cl_int err;

@@ -153,10 +153,20 @@ inline float3 light_rgb(light_t v) { return v; }
 inline float light_max(light_t v) { return fmax(v.x, fmax(v.y, v.z)); }
 #endif
 
+/* The opacity a of one length unit over r units: 1 - (1 - a)^r, written -expm1(r log1p(-a)) so
+ * that a near-transparent a (1e-6) keeps its relative precision, where 1 - a would round it away;
+ * an opaque a stays opaque over any r > 0, and no length is transparent. */
+inline float alpha_for_length(float a, float r)
+{
+    if (!(r > 0.0f))
+        return 0.0f;
+    return a < 1.0f ? -expm1(r * log1p(-a)) : 1.0f;
+}
+
 /* Opacity of a sample whose table alpha was corrected for step h, re-corrected for a step of
- * fraction r of h: 1 - (1 - a)^r. */
+ * fraction r of h. */
 inline float4 alpha_for_fraction(float4 c, float r)
 {
-    c.w = 1.0f - pow(1.0f - c.w, r);
+    c.w = alpha_for_length(c.w, r);
     return c;
 }

@@ -28,7 +28,7 @@ inline float4 preint_substep(__global const float4 *tf, uint tf_size, float s, f
                              uint kind, uint colored)
 {
     float4 c = tf_lookup(tf, tf_size, s);
-    float a = 1.0f - pow(1.0f - c.w, len);
+    float a = alpha_for_length(c.w, len);
     if (kind == PREINT_VIEW)
         return (float4)(c.xyz, a);
     return (float4)(1.0f - a * (colored ? 1.0f - c.xyz : (float3)(1.0f)), 0.0f);
@@ -97,7 +97,7 @@ inline float4 preint_view_for_fraction(float4 e, float r)
 {
     if (r == 1.0f)
         return e;
-    float a = 1.0f - pow(1.0f - e.w, r);
+    float a = alpha_for_length(e.w, r);
     return (float4)(e.xyz * (e.w > 0.0f ? a / e.w : r), a);
 }
 

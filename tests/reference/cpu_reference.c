@@ -79,7 +79,8 @@ static float *corrected(const float *tf, int n, float step_voxels)
         return NULL;
     for (int i = 0; i < n; ++i) {
         memcpy(t + 4 * i, tf + 4 * i, 3 * sizeof *t);
-        t[4 * i + 3] = 1.0f - powf(1.0f - tf[4 * i + 3], step_voxels);
+        double a = tf[4 * i + 3];
+        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
     }
     return t;
 }
@@ -260,7 +261,7 @@ static v3 shadow(const prep *P, v3 p)
     if (last > 0.0f) {
         v3 q = add(p, mul(d, t_start + (float)n_full * h + 0.5f * last));
         lookup(P->light_tf, P->light_n, sample(P, q), c);
-        c[3] = 1.0f - powf(1.0f - c[3], last / h);
+        c[3] = c[3] < 1.0f ? -expm1f(last / h * log1pf(-c[3])) : 1.0f;
         pass(P, c, f);
         for (int ch = 0; ch < 3; ++ch)
             T[ch] *= f[ch];
