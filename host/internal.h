@@ -110,6 +110,8 @@ struct umbra_volume_t {
     uint32_t brick_size;
     uint32_t brick_counts[3];
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
+    float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
+                                brick-major, x fastest (kernels/umbra_shared.h) */
     cl_mem data;             /* normalised float32 voxels (buffer sampler) */
     cl_mem image;            /* CL_R / CL_FLOAT 3D image (image sampler), or NULL */
     uint64_t id;             /* unique per volume, for cache invalidation */

@@ -203,7 +203,8 @@ void umbra_renderer_release(umbra_renderer r)
     release_kernels(r);
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
-                      &r->light_tf_buf, &r->view_bricks_buf, &r->light_bricks_buf, &r->out_buf};
+                      &r->light_tf_buf, &r->view_bricks_buf, &r->light_bricks_buf, &r->view_cells_buf,
+                      &r->out_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         release_mem(mems[i]);
     umbra_volume_release(r->volume);
@@ -470,17 +471,56 @@ fail:
     return st;
 }
 
+/* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
+ * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS). */
+static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    umbra_volume v = r->volume;
+    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    const uint32_t cells = UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS;
+    uint64_t *masks = calloc(n, sizeof *masks);
+    if (!masks)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
+    const float last = (float)(tf->count - 1);
+    for (size_t b = 0; b < n; ++b)
+        for (uint32_t c = 0; c < cells; ++c) {
+            const float *mm = v->cell_minmax + 2 * (b * cells + c);
+            int lo = (int)floorf(mm[0] * last), hi = (int)ceilf(mm[1] * last);
+            lo = lo < 0 ? 0 : lo;
+            hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
+            for (int i = lo; i <= hi; ++i)
+                if (tf->rgba[4 * i + 3] > 0.0f) {
+                    masks[b] |= (uint64_t)1 << c;
+                    break;
+                }
+        }
+    release_mem(buf);
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                          n * sizeof *masks, masks, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(cell table)");
+fail:
+    free(masks);
+    return st;
+}
+
+/* The step-corrected table of tf and its brick table (and, with cell_buf, its cell masks), kept
+ * while tf, the volume and the step stay the same. */
 static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
-                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf)
+                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf, cl_mem *cell_buf)
 {
     uint32_t bits;
     memcpy(&bits, &step_voxels, sizeof bits);
     uint64_t want[3] = {tf->id, r->volume->id, bits};
-    if (*tf_buf && *brick_buf && memcmp(want, key, sizeof want) == 0)
+    if (*tf_buf && *brick_buf && (!cell_buf || *cell_buf) && memcmp(want, key, sizeof want) == 0)
         return UMBRA_SUCCESS;
     umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
     if (st == UMBRA_SUCCESS)
         st = brick_table(r, tf, brick_buf);
+    if (st == UMBRA_SUCCESS && cell_buf)
+        st = cell_table(r, tf, cell_buf);
     if (st == UMBRA_SUCCESS)
         memcpy(key, want, sizeof want);
     else
@@ -491,7 +531,7 @@ static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float s
 umbra_status umbra__light_tables(umbra_renderer r, float step_voxels)
 {
     return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf,
-                  &r->light_bricks_buf);
+                  &r->light_bricks_buf, NULL);
 }
 
 /* ---- per-frame constants ------------------------------------------------------------------------------ */
@@ -721,7 +761,8 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     st = prepare_shadow(r);
     if (st != UMBRA_SUCCESS)
         return st;
-    st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf);
+    st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
+                &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
     frame_update_view(r, width, height);
@@ -762,6 +803,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     }
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &preint));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof preint_size, &preint_size));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->view_cells_buf));
     if (r->tech->bind && (st = r->tech->bind(r, r->render_kernel, next)) != UMBRA_SUCCESS)
         goto fail;
     size_t global[2] = {width, height};

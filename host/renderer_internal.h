@@ -71,6 +71,7 @@ struct umbra_renderer_t {
     cl_mem frame_buf, shadow_buf, samples_buf;
     cl_mem view_tf_buf, light_tf_buf;        /* tables with step-corrected alpha */
     cl_mem view_bricks_buf, light_bricks_buf;/* uchar per brick: nonzero if visible */
+    cl_mem view_cells_buf;                   /* ulong per brick: its visible sub-cells (view) */
     uint64_t view_tf_key[3], light_tf_key[3];/* (tf id, volume id, step bits) they were made for */
     umbra__light_key built;                  /* inputs of the current shadow structure */
     int built_valid;

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "umbra_shared.h"
 
 size_t umbra_scalar_type_size(umbra_scalar_type type)
 {
@@ -106,6 +107,42 @@ static void compute_bricks(umbra_volume v, const float *vox)
             }
 }
 
+/* Min/max over each brick's sub-cells: cell j of brick b along an axis covers the sample
+ * positions [b*B + j*C, b*B + (j+1)*C) with C = ceil(B / UMBRA_BRICK_CELLS), whose trilinear footprint
+ * is voxels [b*B + j*C, b*B + (j+1)*C], clamped to the grid (a cell that starts beyond the last
+ * voxel takes the last voxel: the clamped sampler repeats it there). */
+static void compute_cells(umbra_volume v, const float *vox)
+{
+    const uint32_t B = v->brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    const uint32_t *n = v->dims, *nb = v->brick_counts;
+    size_t i = 0;
+    for (uint32_t bz = 0; bz < nb[2]; ++bz)
+        for (uint32_t by = 0; by < nb[1]; ++by)
+            for (uint32_t bx = 0; bx < nb[0]; ++bx)
+                for (uint32_t c = 0; c < UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS; ++c, ++i) {
+                    const uint32_t cell[3] = {c % UMBRA_BRICK_CELLS, (c / UMBRA_BRICK_CELLS) % UMBRA_BRICK_CELLS,
+                                              c / (UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS)};
+                    const uint32_t brick[3] = {bx, by, bz};
+                    uint32_t lo3[3], hi3[3];
+                    for (int a = 0; a < 3; ++a) {
+                        uint32_t s0 = brick[a] * B + cell[a] * C, s1 = s0 + C;
+                        lo3[a] = s0 < n[a] - 1 ? s0 : n[a] - 1;
+                        hi3[a] = s1 < n[a] - 1 ? s1 : n[a] - 1;
+                    }
+                    float lo = FLT_MAX, hi = -FLT_MAX;
+                    for (uint32_t z = lo3[2]; z <= hi3[2]; ++z)
+                        for (uint32_t y = lo3[1]; y <= hi3[1]; ++y) {
+                            const float *row = vox + ((size_t)z * n[1] + y) * n[0];
+                            for (uint32_t x = lo3[0]; x <= hi3[0]; ++x) {
+                                lo = row[x] < lo ? row[x] : lo;
+                                hi = row[x] > hi ? row[x] : hi;
+                            }
+                        }
+                    v->cell_minmax[2 * i] = lo;
+                    v->cell_minmax[2 * i + 1] = hi;
+                }
+}
+
 umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
                                  umbra_volume *out)
 {
@@ -159,7 +196,9 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     vox = malloc(count * sizeof *vox);
     size_t nbricks = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     v->brick_minmax = malloc(2 * nbricks * sizeof *v->brick_minmax);
-    if (!vox || !v->brick_minmax)
+    v->cell_minmax = malloc(2 * nbricks * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS *
+                            sizeof *v->cell_minmax);
+    if (!vox || !v->brick_minmax || !v->cell_minmax)
         goto oom;
     const float scale = 1.0f / (hi - lo);
     for (size_t i = 0; i < count; ++i) {
@@ -167,6 +206,7 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
         vox[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : (x == x ? x : 0.0f));
     }
     compute_bricks(v, vox);
+    compute_cells(v, vox);
 
     cl_int err;
     if (ctx->sampler == UMBRA_SAMPLER_IMAGE) {
@@ -233,6 +273,7 @@ void umbra_volume_release(umbra_volume v)
     if (v->image)
         clReleaseMemObject(v->image);
     free(v->brick_minmax);
+    free(v->cell_minmax);
     umbra_context_release(v->ctx);
     free(v);
 }

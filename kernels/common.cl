@@ -79,13 +79,44 @@ inline float3 world_to_voxel(VolGeom g, float3 p)
     return (p - g.box_min) * g.inv_spacing - 0.5f;
 }
 
-/* Index of the brick whose trilinear footprint contains p (positions outside the grid clamp to
- * the border bricks, as the sampler clamps to the border voxels). */
-inline int brick_index(VolGeom g, float3 p)
+/* Grid coordinates of the brick whose trilinear footprint contains p (positions outside the grid
+ * clamp to the border bricks, as the sampler clamps to the border voxels). */
+inline int3 brick_coords(VolGeom g, float3 p)
 {
     float3 x = world_to_voxel(g, p) / (float)g.brick_size;
-    int3 b = clamp(convert_int3(floor(x)), (int3)(0), g.bricks - 1);
+    return clamp(convert_int3(floor(x)), (int3)(0), g.bricks - 1);
+}
+
+inline int brick_index(VolGeom g, float3 p)
+{
+    int3 b = brick_coords(g, p);
     return (b.z * g.bricks.y + b.y) * g.bricks.x + b.x;
+}
+
+/* The sub-cell (UMBRA_BRICK_CELLS per axis) of p within the brick whose first voxel is origin
+ * (brick coordinates times brick_size); cell is the cell size in voxels. */
+inline int3 cell_coords(VolGeom g, float3 origin, float cell, float3 p)
+{
+    return clamp(convert_int3(floor((world_to_voxel(g, p) - origin) / cell)), (int3)(0),
+                 (int3)(UMBRA_BRICK_CELLS - 1));
+}
+
+/* Whether sub-cell c is visible in a brick's cell mask. */
+inline bool cell_visible(ulong mask, int3 c)
+{
+    int bit = (c.z * UMBRA_BRICK_CELLS + c.y) * UMBRA_BRICK_CELLS + c.x;
+    return ((mask >> bit) & 1UL) != 0UL;
+}
+
+/* The ray parameter at which o + t d leaves sub-cell c of the brick whose first voxel is origin
+ * (a point clamped into the cell may lie behind its exit: the caller steps at least one sample). */
+inline float cell_exit(VolGeom g, float3 o, float3 d, float3 origin, float cell, int3 c)
+{
+    float3 lo = (origin + convert_float3(c) * cell + 0.5f) * g.spacing + g.box_min;
+    float3 hi = lo + cell * g.spacing;
+    float3 t = select((lo - o) / d, (hi - o) / d, d > 0.0f);
+    t = select(t, (float3)(UMBRA_INF), d == 0.0f);
+    return fmin(fmin(t.x, t.y), t.z);
 }
 
 /* The ray parameter at which o + t d leaves the brick containing o + t_now d. */

@@ -54,7 +54,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const uchar *view_bricks, __global const uchar *light_bricks,
                              __global const UmbraShadow *S, __global float4 *out,
                              __global UMBRA_COUNT_T *samples, __global const float4 *preint,
-                             uint preint_size SHADOW_KERNEL_PARAMS)
+                             uint preint_size, __global const ulong *view_cells SHADOW_KERNEL_PARAMS)
 {
     const int px = get_global_id(0), py = get_global_id(1);
     if (px >= (int)F->width || py >= (int)F->height)
@@ -98,16 +98,37 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
          * once per brick crossed, not once per sample (per-sample lookups cost more than the
          * trilinear fetch on CPUs). */
         float t_visible = -UMBRA_INF;
+        /* Inside a visible brick the ray also jumps over its invisible sub-cells (not in
+         * pre-integrated mode, whose segments reach into the next sample's cell): the brick's
+         * cell mask and first voxel are read when the ray enters it. */
+        const int skip_cells = skip && !preint_size;
+        const float cell = (float)((g.brick_size + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS);
+        ulong cells = ~0UL;
+        float3 cell_origin = (float3)(0.0f);
         for (int k = 0; k < n;) {
             float t = t0 + ((float)k + jitter) * h;
             float3 p = o + t * d;
             if (skip && t >= t_visible) {
                 float t_exit = brick_exit(g, o, d, t);
-                if (view_bricks[brick_index(g, p)]) {
+                int3 b = brick_coords(g, p);
+                int bi = (b.z * g.bricks.y + b.y) * g.bricks.x + b.x;
+                if (view_bricks[bi]) {
                     t_visible = t_exit;
+                    if (skip_cells) {
+                        cells = view_cells[bi];
+                        cell_origin = convert_float3(b * g.brick_size);
+                    }
                 } else if (!(preint_size && view_bricks[brick_index(g, p + h * d)])) {
                     int next = next_sample_after(t0, h, jitter, t_exit, k);
                     k = preint_size ? max(next - 1, k + 1) : next;
+                    continue;
+                }
+            }
+            if (skip_cells) {
+                int3 c = cell_coords(g, cell_origin, cell, p);
+                if (!cell_visible(cells, c)) {
+                    float t_exit = fmin(cell_exit(g, o, d, cell_origin, cell, c), t_visible);
+                    k = next_sample_after(t0, h, jitter, t_exit, k);
                     continue;
                 }
             }

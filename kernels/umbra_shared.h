@@ -15,6 +15,12 @@ typedef int int32_t;
 #include <stdint.h>
 #endif
 
+/* Empty-space skipping: each brick of the volume is split into UMBRA_BRICK_CELLS^3 sub-cells of
+ * ceil(brick_size / UMBRA_BRICK_CELLS) voxels, one bit each (x fastest) of a 64-bit mask per
+ * brick. View rays jump over invisible bricks and, inside a visible one, skip single samples that
+ * fall in an invisible sub-cell (kernels/raycast.cl); host/volume.c keeps the cells' ranges. */
+#define UMBRA_BRICK_CELLS 4
+
 /* Flags in UmbraFrame.flags. */
 #define UMBRA_FLAG_JITTER 1u
 #define UMBRA_FLAG_SKIP_EMPTY 2u

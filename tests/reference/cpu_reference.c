@@ -32,6 +32,7 @@ typedef struct prep {
     float *view_tf, *light_tf;    /* alpha corrected for the view step / the shadow step */
     int view_n, light_n;
     unsigned char *view_bricks, *light_bricks;
+    uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
     int nb[3], B;
     float step, shadow_step;
     int colored, point;
@@ -115,6 +116,82 @@ static unsigned char *bricks(const prep *P, const float *tf, int n)
     return out;
 }
 
+/* The kernels' UMBRA_BRICK_CELLS (kernels/umbra_shared.h): each brick split into CELLS^3
+ * sub-cells of ceil(B / CELLS) voxels. Bit (x + CELLS (y + CELLS z)) of a brick's mask is set if
+ * a voxel of the sub-cell's trilinear footprint (clamped to the grid; a cell beyond the last
+ * voxel takes the last voxel) maps to alpha > 0. */
+enum { CELLS = 4 };
+
+static uint64_t *cells(const prep *P, const float *tf, int n)
+{
+    const cpu_scene *s = P->s;
+    const int B = P->B, C = (P->B + CELLS - 1) / CELLS;
+    uint64_t *out = calloc((size_t)P->nb[0] * P->nb[1] * P->nb[2], sizeof *out);
+    if (!out)
+        return NULL;
+    for (int bz = 0; bz < P->nb[2]; ++bz)
+        for (int by = 0; by < P->nb[1]; ++by)
+            for (int bx = 0; bx < P->nb[0]; ++bx)
+                for (int c = 0; c < CELLS * CELLS * CELLS; ++c) {
+                    int cell[3] = {c % CELLS, (c / CELLS) % CELLS, c / (CELLS * CELLS)};
+                    int brick[3] = {bx, by, bz}, lo3[3], hi3[3];
+                    for (int a = 0; a < 3; ++a) {
+                        int s0 = brick[a] * B + cell[a] * C, last = s->dims[a] - 1;
+                        lo3[a] = s0 < last ? s0 : last;
+                        hi3[a] = s0 + C < last ? s0 + C : last;
+                    }
+                    float lo = FLT_MAX, hi = -FLT_MAX;
+                    for (int z = lo3[2]; z <= hi3[2]; ++z)
+                        for (int y = lo3[1]; y <= hi3[1]; ++y)
+                            for (int x = lo3[0]; x <= hi3[0]; ++x) {
+                                float v = s->voxels[((size_t)z * s->dims[1] + y) * s->dims[0] + x];
+                                lo = v < lo ? v : lo;
+                                hi = v > hi ? v : hi;
+                            }
+                    int a = (int)floorf(lo * (n - 1)), b = (int)ceilf(hi * (n - 1));
+                    a = a < 0 ? 0 : a;
+                    b = b > n - 1 ? n - 1 : b;
+                    for (int i = a; i <= b; ++i)
+                        if (tf[4 * i + 3] > 0.0f) {
+                            out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] |= (uint64_t)1 << c;
+                            break;
+                        }
+                }
+    return out;
+}
+
+/* The sub-cell of p in brick b (the kernels' cell_coords); returns its bit in the brick's mask. */
+static int cell_of(const prep *P, const int b[3], v3 p, int c[3])
+{
+    const float cell = (float)((P->B + CELLS - 1) / CELLS);
+    float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+                  (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+                  (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    for (int a = 0; a < 3; ++a) {
+        int i = (int)floorf((x[a] - (float)(b[a] * P->B)) / cell);
+        c[a] = i < 0 ? 0 : (i > CELLS - 1 ? CELLS - 1 : i);
+    }
+    return (c[2] * CELLS + c[1]) * CELLS + c[0];
+}
+
+/* Ray parameter where o + t d leaves sub-cell c of brick b (the kernels' cell_exit). */
+static float cell_exit(const prep *P, v3 o, v3 d, const int b[3], const int c[3])
+{
+    const float cell = (float)((P->B + CELLS - 1) / CELLS);
+    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, sp[3] = {P->spacing.x, P->spacing.y, P->spacing.z};
+    float t = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        float lo = ((float)(b[a] * P->B) + (float)c[a] * cell + 0.5f) * sp[a] + bmin[a];
+        float hi = lo + cell * sp[a];
+        if (dd[a] > 0.0f)
+            t = fminf(t, (hi - oo[a]) / dd[a]);
+        else if (dd[a] < 0.0f)
+            t = fminf(t, (lo - oo[a]) / dd[a]);
+    }
+    return t;
+}
+
 static void prep_init(prep *P, const cpu_scene *s)
 {
     memset(P, 0, sizeof *P);
@@ -136,6 +213,7 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->view_tf = corrected(s->tf, s->tf_count, s->opts.step);
     P->light_tf = corrected(ltf, P->light_n, s->reference_step);
     P->view_bricks = bricks(P, s->tf, s->tf_count);
+    P->view_cells = cells(P, s->tf, s->tf_count);
     P->light_bricks = bricks(P, ltf, P->light_n);
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
     P->point = s->light.type == UMBRA_LIGHT_POINT;
@@ -147,6 +225,7 @@ static void prep_free(prep *P)
     free(P->view_tf);
     free(P->light_tf);
     free(P->view_bricks);
+    free(P->view_cells);
     free(P->light_bricks);
 }
 
@@ -355,16 +434,29 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             float jitter = o->jitter ? random01(o->seed, (uint32_t)px, (uint32_t)py, 0u) : 0.0f;
             int n = (int)ceilf((t1 - t0) / hstep - jitter), b[3];
             float t_visible = -INFINITY; /* samples before it lie in a brick found visible */
+            uint64_t mask = ~(uint64_t)0;  /* that brick's visible sub-cells */
+            int cb[3] = {0, 0, 0};        /* and its grid coordinates */
             for (int k = 0; k < n;) {
                 float t = t0 + ((float)k + jitter) * hstep;
                 v3 p = add(org, mul(d, t));
                 if (o->empty_space_skipping && t >= t_visible) {
                     float t_exit = brick_exit(P, org, d, t);
-                    if (!P->view_bricks[brick_of(P, p, b)]) {
+                    int bi = brick_of(P, p, b);
+                    if (!P->view_bricks[bi]) {
                         k = next_after(t0, hstep, jitter, t_exit, k);
                         continue;
                     }
                     t_visible = t_exit;
+                    mask = P->view_cells[bi];
+                    memcpy(cb, b, sizeof cb);
+                }
+                if (o->empty_space_skipping) {
+                    int c3[3];
+                    if (!((mask >> cell_of(P, cb, p, c3)) & 1u)) {
+                        float te = fminf(cell_exit(P, org, d, cb, c3), t_visible);
+                        k = next_after(t0, hstep, jitter, te, k);
+                        continue;
+                    }
                 }
                 ++taken;
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
@@ -425,7 +517,8 @@ cpu_prepared *cpu_prepare(const cpu_scene *s)
     if (!p)
         return NULL;
     prep_init(&p->P, s);
-    if (!p->P.view_tf || !p->P.light_tf || !p->P.view_bricks || !p->P.light_bricks) {
+    if (!p->P.view_tf || !p->P.light_tf || !p->P.view_bricks || !p->P.light_bricks ||
+        !p->P.view_cells) {
         cpu_prepared_free(p);
         return NULL;
     }
