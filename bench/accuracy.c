@@ -391,18 +391,6 @@ static void format_duration(double ms, char *buf, size_t size)
         snprintf(buf, size, "%lds", s);
 }
 
-static void format_bytes(size_t b, char *buf, size_t size)
-{
-    if (b == 0)
-        snprintf(buf, size, "0");
-    else if (b >= (size_t)1 << 30)
-        snprintf(buf, size, "%.2f GiB", (double)b / (double)((size_t)1 << 30));
-    else if (b >= (size_t)1 << 20)
-        snprintf(buf, size, "%.1f MiB", (double)b / (double)((size_t)1 << 20));
-    else
-        snprintf(buf, size, "%.1f KiB", (double)b / 1024.0);
-}
-
 /* Replaces characters that would break a CSV field or a file name. */
 static void sanitize(char *s, int for_file)
 {
@@ -1137,16 +1125,6 @@ static int main_scene(const bench_run *B)
     return first;
 }
 
-static void fmt_ms(double ms, char *buf, size_t size)
-{
-    if (ms >= 100.0)
-        snprintf(buf, size, "%.0f", ms);
-    else if (ms >= 10.0)
-        snprintf(buf, size, "%.1f", ms);
-    else
-        snprintf(buf, size, "%.2f", ms);
-}
-
 static void fmt_ratio(double x, char *buf, size_t size)
 {
     if (!(x > 0.0) || !isfinite(x))
@@ -1200,7 +1178,7 @@ static void headline_table(const bench_run *B, FILE *f, int si)
         else
             snprintf(b, sizeof b, "–");
         if (nmem)
-            format_bytes((size_t)exp(lmem / nmem), m, sizeof m);
+            bench_format_bytes((size_t)exp(lmem / nmem), m, sizeof m);
         else
             snprintf(m, sizeof m, "0");
         fmt_ratio(exp(lsp / n), sp, sizeof sp);
@@ -1243,7 +1221,7 @@ static void write_headline(bench_run *B)
         const result *none = find_headline(B, ms, H_NONE);
         char t[32] = "?";
         if (none)
-            fmt_ms(none->render_ms, t, sizeof t);
+            bench_format_ms(none->render_ms, t, sizeof t);
         fprintf(f, "**%s** (%ux%u, unshadowed frame %s ms):\n\n", B->scenes[ms].name,
                 none ? none->width : 0, none ? none->height : 0, t);
         headline_table(B, f, ms);
@@ -1313,11 +1291,11 @@ static void write_summary(bench_run *B)
             if (r->scene != si)
                 continue;
             char b[32], rd[32], ov[32], bf[32], mem[32], sp[32], psnr[32], runs[32];
-            fmt_ms(r->build_ms, b, sizeof b);
-            fmt_ms(r->render_ms, rd, sizeof rd);
+            bench_format_ms(r->build_ms, b, sizeof b);
+            bench_format_ms(r->render_ms, rd, sizeof rd);
             fmt_ratio(r->none_ms > 0 ? r->render_ms / r->none_ms : 0, ov, sizeof ov);
             fmt_ratio(r->none_ms > 0 ? r->build_ms / r->none_ms : 0, bf, sizeof bf);
-            format_bytes(r->memory, mem, sizeof mem);
+            bench_format_bytes(r->memory, mem, sizeof mem);
             fmt_ratio(r->reference_ms / r->total_ms, sp, sizeof sp);
             if (isinf(r->err.psnr_db))
                 snprintf(psnr, sizeof psnr, "∞");
@@ -1424,7 +1402,7 @@ static void cssm_table(FILE *f, const char *title, const double paper[3][3], dou
     for (int m = 0; m < 3; ++m)
         for (int t = 0; t < 3; ++t) {
             char o[32], pr[32], orr[32], ps[32], os[32];
-            fmt_ms(ours[m][t], o, sizeof o);
+            bench_format_ms(ours[m][t], o, sizeof o);
             fmt_ratio(paper[m][t] / paper[m][0], pr, sizeof pr);
             fmt_ratio(ours[m][0] > 0 ? ours[m][t] / ours[m][0] : 0, orr, sizeof orr);
             fmt_ratio(paper[m][t] / paper[0][t], ps, sizeof ps);
@@ -1530,8 +1508,8 @@ static void write_papers(bench_run *B)
                 if (!r[e])
                     continue;
                 char ms[32], mem[32], pe[32] = "", oe[32] = "", ps[32], os[32];
-                fmt_ms(r[e]->build_ms, ms, sizeof ms);
-                format_bytes(r[e]->memory, mem, sizeof mem);
+                bench_format_ms(r[e]->build_ms, ms, sizeof ms);
+                bench_format_bytes(r[e]->memory, mem, sizeof mem);
                 if (e == 1 && r[0]) {
                     fmt_ratio(paper_mid[s][1] / paper_mid[s][0], pe, sizeof pe);
                     fmt_ratio(r[0]->build_ms / r[1]->build_ms, oe, sizeof oe);

@@ -93,4 +93,9 @@ int bench_parse_size(const char *s, uint32_t *w, uint32_t *h); /* "WxH", each in
  * stderr and returns NULL on failure. */
 umbra_context bench_context(const char *device);
 
+/* Table formatting shared by the subcommands: "0", "812.0 KiB", "3.1 MiB", "1.25 GiB"; and
+ * milliseconds with three significant digits ("1234", "56.7", "8.91"). */
+void bench_format_bytes(size_t bytes, char *buf, size_t size);
+void bench_format_ms(double ms, char *buf, size_t size);
+
 #endif

@@ -425,3 +425,25 @@ void bench_volume_free(bench_volume *v)
     }
     memset(v, 0, sizeof *v);
 }
+
+void bench_format_bytes(size_t b, char *buf, size_t size)
+{
+    if (b == 0)
+        snprintf(buf, size, "0");
+    else if (b >= (size_t)1 << 30)
+        snprintf(buf, size, "%.2f GiB", (double)b / (double)((size_t)1 << 30));
+    else if (b >= (size_t)1 << 20)
+        snprintf(buf, size, "%.1f MiB", (double)b / (double)((size_t)1 << 20));
+    else
+        snprintf(buf, size, "%.1f KiB", (double)b / 1024.0);
+}
+
+void bench_format_ms(double ms, char *buf, size_t size)
+{
+    if (ms >= 100.0)
+        snprintf(buf, size, "%.0f", ms);
+    else if (ms >= 10.0)
+        snprintf(buf, size, "%.1f", ms);
+    else
+        snprintf(buf, size, "%.2f", ms);
+}

@@ -117,32 +117,6 @@ static void image_name(const char *technique, const char *params, char *out, siz
             *s = '_';
 }
 
-static void format_bytes(double b, char *out, size_t size)
-{
-    if (b <= 0.0)
-        snprintf(out, size, "0");
-    else if (b >= 1024.0 * 1024.0 * 1024.0)
-        snprintf(out, size, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
-    else if (b >= 1024.0 * 1024.0)
-        snprintf(out, size, "%.1f MiB", b / (1024.0 * 1024.0));
-    else if (b >= 1024.0)
-        snprintf(out, size, "%.1f KiB", b / 1024.0);
-    else
-        snprintf(out, size, "%.0f B", b);
-}
-
-static void format_ms(double ms, char *out, size_t size)
-{
-    if (!(ms > 0.0))
-        snprintf(out, size, "–");
-    else if (ms >= 100.0)
-        snprintf(out, size, "%.0f", ms);
-    else if (ms >= 10.0)
-        snprintf(out, size, "%.1f", ms);
-    else
-        snprintf(out, size, "%.2f", ms);
-}
-
 /* Splits a CSV line (no quoting: accuracy.csv has none) in place; returns the field count. */
 static int split_csv(char *line, char **fields, int max)
 {
@@ -254,9 +228,13 @@ static int block_gallery(const job *J, text *out)
                                   "|---|---|---|---:|---:|---:|---:|---:|---:|\n",
                              v[col[WIDTH]], v[col[HEIGHT]]);
         char build[32], render[32], mem[32];
-        format_ms(atof(v[col[BUILD]]), build, sizeof build);
-        format_ms(atof(v[col[RENDER]]), render, sizeof render);
-        format_bytes(atof(v[col[MEM]]), mem, sizeof mem);
+        const double build_ms = atof(v[col[BUILD]]);
+        if (build_ms > 0.0)
+            bench_format_ms(build_ms, build, sizeof build);
+        else
+            snprintf(build, sizeof build, "–");
+        bench_format_ms(atof(v[col[RENDER]]), render, sizeof render);
+        bench_format_bytes((size_t)atof(v[col[MEM]]), mem, sizeof mem);
         const int exact = strcmp(v[col[TECH]], "reference") == 0 && atof(v[col[RMSE]]) == 0.0;
         char label[256];
         snprintf(label, sizeof label, "%s", v[col[LABEL]]);

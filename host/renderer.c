@@ -442,68 +442,63 @@ fail:
     return st;
 }
 
-/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
-static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+/* Whether some table entry that values in [minmax[0], minmax[1]] interpolate has alpha > 0. */
+static int range_visible(umbra_transfer_function tf, const float minmax[2])
+{
+    const float last = (float)(tf->count - 1);
+    int lo = (int)floorf(minmax[0] * last), hi = (int)ceilf(minmax[1] * last);
+    lo = lo < 0 ? 0 : lo;
+    hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
+    for (int i = lo; i <= hi; ++i)
+        if (tf->rgba[4 * i + 3] > 0.0f)
+            return 1;
+    return 0;
+}
+
+/* Replaces *buf by a read-only device copy of host (bytes long, freed here; NULL: out of
+ * memory). what names the table in an error. */
+static umbra_status upload_table(umbra_renderer r, void *host, size_t bytes, const char *what,
+                                 cl_mem *buf)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    umbra_volume v = r->volume;
-    size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
-    unsigned char *flags = malloc(n);
-    if (!flags)
-        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
-    const float last = (float)(tf->count - 1);
-    for (size_t b = 0; b < n; ++b) {
-        int lo = (int)floorf(v->brick_minmax[2 * b] * last);
-        int hi = (int)ceilf(v->brick_minmax[2 * b + 1] * last);
-        lo = lo < 0 ? 0 : lo;
-        hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
-        flags[b] = 0;
-        for (int i = lo; i <= hi && !flags[b]; ++i)
-            flags[b] = tf->rgba[4 * i + 3] > 0.0f;
-    }
+    if (!host)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "umbra_renderer_render: out of memory for the %s", what);
     release_mem(buf);
     cl_int err;
-    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n, flags, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(brick table)");
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, host,
+                          &err);
+    UMBRA_CL_CHECK(err, what);
 fail:
-    free(flags);
+    free(host);
     return st;
+}
+
+/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
+static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+{
+    umbra_volume v = r->volume;
+    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    unsigned char *flags = malloc(n);
+    for (size_t b = 0; flags && b < n; ++b)
+        flags[b] = (unsigned char)range_visible(tf, v->brick_minmax + 2 * b);
+    return upload_table(r, flags, n, "brick table", buf);
 }
 
 /* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
  * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS). */
 static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
 {
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
     umbra_volume v = r->volume;
     const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     const uint32_t cells = UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS;
     uint64_t *masks = calloc(n, sizeof *masks);
-    if (!masks)
-        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
-    const float last = (float)(tf->count - 1);
-    for (size_t b = 0; b < n; ++b)
-        for (uint32_t c = 0; c < cells; ++c) {
-            const float *mm = v->cell_minmax + 2 * (b * cells + c);
-            int lo = (int)floorf(mm[0] * last), hi = (int)ceilf(mm[1] * last);
-            lo = lo < 0 ? 0 : lo;
-            hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
-            for (int i = lo; i <= hi; ++i)
-                if (tf->rgba[4 * i + 3] > 0.0f) {
-                    masks[b] |= (uint64_t)1 << c;
-                    break;
-                }
-        }
-    release_mem(buf);
-    cl_int err;
-    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                          n * sizeof *masks, masks, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(cell table)");
-fail:
-    free(masks);
-    return st;
+    for (size_t b = 0; masks && b < n; ++b)
+        for (uint32_t c = 0; c < cells; ++c)
+            if (range_visible(tf, v->cell_minmax + 2 * (b * cells + c)))
+                masks[b] |= (uint64_t)1 << c;
+    return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
 }
 
 /* The step-corrected table of tf and its brick table (and, with cell_buf, its cell masks), kept

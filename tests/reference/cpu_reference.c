@@ -86,6 +86,18 @@ static float *corrected(const float *tf, int n, float step_voxels)
     return t;
 }
 
+/* Whether some table entry that values in [lo, hi] interpolate has alpha > 0. */
+static int range_visible(const float *tf, int n, float lo, float hi)
+{
+    int a = (int)floorf(lo * (n - 1)), b = (int)ceilf(hi * (n - 1));
+    a = a < 0 ? 0 : a;
+    b = b > n - 1 ? n - 1 : b;
+    for (int i = a; i <= b; ++i)
+        if (tf[4 * i + 3] > 0.0f)
+            return 1;
+    return 0;
+}
+
 /* 1 per brick if any voxel its trilinear footprint reads maps to alpha > 0. */
 static unsigned char *bricks(const prep *P, const float *tf, int n)
 {
@@ -105,13 +117,8 @@ static unsigned char *bricks(const prep *P, const float *tf, int n)
                             lo = v < lo ? v : lo;
                             hi = v > hi ? v : hi;
                         }
-                int a = (int)floorf(lo * (n - 1)), b = (int)ceilf(hi * (n - 1));
-                a = a < 0 ? 0 : a;
-                b = b > n - 1 ? n - 1 : b;
-                unsigned char vis = 0;
-                for (int i = a; i <= b; ++i)
-                    vis |= tf[4 * i + 3] > 0.0f;
-                out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] = vis;
+                out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] =
+                    (unsigned char)range_visible(tf, n, lo, hi);
             }
     return out;
 }
@@ -148,14 +155,8 @@ static uint64_t *cells(const prep *P, const float *tf, int n)
                                 lo = v < lo ? v : lo;
                                 hi = v > hi ? v : hi;
                             }
-                    int a = (int)floorf(lo * (n - 1)), b = (int)ceilf(hi * (n - 1));
-                    a = a < 0 ? 0 : a;
-                    b = b > n - 1 ? n - 1 : b;
-                    for (int i = a; i <= b; ++i)
-                        if (tf[4 * i + 3] > 0.0f) {
-                            out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] |= (uint64_t)1 << c;
-                            break;
-                        }
+                    if (range_visible(tf, n, lo, hi))
+                        out[((size_t)bz * P->nb[1] + by) * P->nb[0] + bx] |= (uint64_t)1 << c;
                 }
     return out;
 }
