@@ -243,11 +243,11 @@ static int block_gallery(const job *J, text *out)
                 *s = ','; /* accuracy.csv writes the labels' commas as ';' */
         if (rc == 0)
             rc = text_printf(out, "| ![%s %s](%s/images/%s/%s.png) | %s%s%s | %s | %s | %s | %s "
-                                  "| %s | %s | %s |\n",
+                                  "| %s | %.4f | %.4f |\n",
                              v[col[TECH]], label, J->link, J->scene, name, exact ? "**" : "",
                              v[col[TECH]], exact ? "**" : "", label, build, render, mem,
-                             v[col[CHANNELS]], exact ? "0" : v[col[RMSE]],
-                             exact ? "1" : v[col[SSIM]]);
+                             v[col[CHANNELS]], exact ? 0.0 : atof(v[col[RMSE]]),
+                             exact ? 1.0 : atof(v[col[SSIM]]));
     }
     fclose(f);
     if (rc == 0 && rows == 0) {
