@@ -94,10 +94,10 @@ inline int brick_index(VolGeom g, float3 p)
 }
 
 /* The sub-cell (UMBRA_BRICK_CELLS per axis) of p within the brick whose first voxel is origin
- * (brick coordinates times brick_size); cell is the cell size in voxels. */
-inline int3 cell_coords(VolGeom g, float3 origin, float cell, float3 p)
+ * (brick coordinates times brick_size); inv_cell is 1 / the cell size in voxels. */
+inline int3 cell_coords(VolGeom g, float3 origin, float inv_cell, float3 p)
 {
-    return clamp(convert_int3(floor((world_to_voxel(g, p) - origin) / cell)), (int3)(0),
+    return clamp(convert_int3(floor((world_to_voxel(g, p) - origin) * inv_cell)), (int3)(0),
                  (int3)(UMBRA_BRICK_CELLS - 1));
 }
 

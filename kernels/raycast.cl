@@ -100,11 +100,14 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         float t_visible = -UMBRA_INF;
         /* Inside a visible brick the ray also jumps over its invisible sub-cells (not in
          * pre-integrated mode, whose segments reach into the next sample's cell): the brick's
-         * cell mask and first voxel are read when the ray enters it. */
+         * cell mask and first voxel are read when the ray enters it, and like bricks a cell found
+         * visible is not tested again before t_cell, its exit. */
         const int skip_cells = skip && !preint_size;
         const float cell = (float)((g.brick_size + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS);
+        const float inv_cell = 1.0f / cell;
         ulong cells = ~0UL;
         float3 cell_origin = (float3)(0.0f);
+        float t_cell = -UMBRA_INF;
         for (int k = 0; k < n;) {
             float t = t0 + ((float)k + jitter) * h;
             float3 p = o + t * d;
@@ -124,13 +127,14 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                     continue;
                 }
             }
-            if (skip_cells) {
-                int3 c = cell_coords(g, cell_origin, cell, p);
+            if (skip_cells && t >= t_cell) {
+                int3 c = cell_coords(g, cell_origin, inv_cell, p);
+                float t_exit = fmin(cell_exit(g, o, d, cell_origin, cell, c), t_visible);
                 if (!cell_visible(cells, c)) {
-                    float t_exit = fmin(cell_exit(g, o, d, cell_origin, cell, c), t_visible);
                     k = next_sample_after(t0, h, jitter, t_exit, k);
                     continue;
                 }
+                t_cell = t_exit;
             }
             ++taken;
             float4 c;

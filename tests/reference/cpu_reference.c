@@ -164,12 +164,12 @@ static uint64_t *cells(const prep *P, const float *tf, int n)
 /* The sub-cell of p in brick b (the kernels' cell_coords); returns its bit in the brick's mask. */
 static int cell_of(const prep *P, const int b[3], v3 p, int c[3])
 {
-    const float cell = (float)((P->B + CELLS - 1) / CELLS);
+    const float inv_cell = 1.0f / (float)((P->B + CELLS - 1) / CELLS);
     float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
                   (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
                   (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
     for (int a = 0; a < 3; ++a) {
-        int i = (int)floorf((x[a] - (float)(b[a] * P->B)) / cell);
+        int i = (int)floorf((x[a] - (float)(b[a] * P->B)) * inv_cell);
         c[a] = i < 0 ? 0 : (i > CELLS - 1 ? CELLS - 1 : i);
     }
     return (c[2] * CELLS + c[1]) * CELLS + c[0];
@@ -436,6 +436,7 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             int n = (int)ceilf((t1 - t0) / hstep - jitter), b[3];
             float t_visible = -INFINITY; /* samples before it lie in a brick found visible */
             uint64_t mask = ~(uint64_t)0;  /* that brick's visible sub-cells */
+            float t_cell = -INFINITY;     /* samples before it lie in a sub-cell found visible */
             int cb[3] = {0, 0, 0};        /* and its grid coordinates */
             for (int k = 0; k < n;) {
                 float t = t0 + ((float)k + jitter) * hstep;
@@ -451,13 +452,15 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                     mask = P->view_cells[bi];
                     memcpy(cb, b, sizeof cb);
                 }
-                if (o->empty_space_skipping) {
+                if (o->empty_space_skipping && t >= t_cell) {
                     int c3[3];
-                    if (!((mask >> cell_of(P, cb, p, c3)) & 1u)) {
-                        float te = fminf(cell_exit(P, org, d, cb, c3), t_visible);
+                    int bit = cell_of(P, cb, p, c3);
+                    float te = fminf(cell_exit(P, org, d, cb, c3), t_visible);
+                    if (!((mask >> bit) & 1u)) {
                         k = next_after(t0, hstep, jitter, te, k);
                         continue;
                     }
+                    t_cell = te;
                 }
                 ++taken;
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
