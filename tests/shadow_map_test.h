@@ -25,28 +25,6 @@
 #define MT_NY 32u
 #define MT_NZ 48u
 
-static inline umbra_light mt_directional(float x, float y, float z)
-{
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
-}
-
-static inline umbra_light mt_point(float x, float y, float z)
-{
-    umbra_light l = mt_directional(0.0f, -1.0f, 0.0f);
-    l.type = UMBRA_LIGHT_POINT;
-    l.position[0] = x;
-    l.position[1] = y;
-    l.position[2] = z;
-    return l;
-}
-
 /* A constant transfer function of colour (r, g, b) and per-voxel alpha a. */
 static inline umbra_transfer_function mt_tf(umbra_context ctx, float r, float g, float b, float a)
 {
@@ -161,17 +139,17 @@ static inline void mt_check_stress_lights(umbra_context ctx, umbra_shadow_desc s
         umbra_light light;
         const char *what;
     } cases[] = {
-        {mt_directional(0, -1, 0), "down the y axis"},
-        {mt_directional(0, 1, 0), "up the y axis"},
-        {mt_directional(1, 0, 0), "along +x"},
-        {mt_directional(0, 0, -1), "along -z"},
-        {mt_directional(1, -1e-3f, 0), "grazing, 0.06 degrees"},
-        {mt_directional(0.3f, 1e-6f, -1), "grazing, 6e-5 degrees"},
-        {mt_point(0, h, 0), "point on the top face"},
-        {mt_point(-h, -h, h), "point on a corner"},
-        {mt_point(h + 0.01f, 3, -2), "point just outside a face"},
-        {mt_point(0, 0, 0), "point inside, centre"},
-        {mt_point(5, -4, 3), "point inside the ball"},
+        {test_directional_light(0, -1, 0), "down the y axis"},
+        {test_directional_light(0, 1, 0), "up the y axis"},
+        {test_directional_light(1, 0, 0), "along +x"},
+        {test_directional_light(0, 0, -1), "along -z"},
+        {test_directional_light(1, -1e-3f, 0), "grazing, 0.06 degrees"},
+        {test_directional_light(0.3f, 1e-6f, -1), "grazing, 6e-5 degrees"},
+        {test_point_light(0, h, 0), "point on the top face"},
+        {test_point_light(-h, -h, h), "point on a corner"},
+        {test_point_light(h + 0.01f, 3, -2), "point just outside a face"},
+        {test_point_light(0, 0, 0), "point inside, centre"},
+        {test_point_light(5, -4, 3), "point inside the ball"},
     };
     enum { CLOUD = 7 * 7 * 7, W = 40, H = 40 };
     float *pts = malloc(CLOUD * 3 * sizeof *pts), *rgb = malloc(CLOUD * 3 * sizeof *rgb);

@@ -31,36 +31,6 @@
 
 /* ---- helpers --------------------------------------------------------------------------------- */
 
-static umbra_volume make_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
-                                const float *data)
-{
-    umbra_volume_desc d;
-    umbra_volume_desc_init(&d);
-    d.data = data;
-    d.type = UMBRA_FLOAT32;
-    d.dims[0] = nx;
-    d.dims[1] = ny;
-    d.dims[2] = nz;
-    d.value_range_given = 1;
-    d.value_min = 0.0f;
-    d.value_max = 1.0f;
-    umbra_volume v = NULL;
-    assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
-    return v;
-}
-
-static umbra_light directional(float x, float y, float z)
-{
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
-}
-
 /* An orthographic camera above the origin looking straight down (-y), image x along +x. */
 static umbra_camera camera_down(float height, float ortho_height)
 {
@@ -126,7 +96,7 @@ static void slab_light(umbra_context ctx, const umbra_light *light, int variant,
     assert_non_null(data);
     for (size_t i = 0; i < (size_t)SLAB_N * SLAB_H * SLAB_N; ++i)
         data[i] = 1.0f;
-    umbra_volume v = make_volume(ctx, SLAB_N, SLAB_H, SLAB_N, data);
+    umbra_volume v = test_volume(ctx, SLAB_N, SLAB_H, SLAB_N, data);
     free(data);
     umbra_transfer_function tf = test_constant_tf(ctx, 0.7f, 0.03f);
     umbra_camera cam = camera_down(20.0f, 16.0f);
@@ -158,7 +128,7 @@ static void test_slab_light_matches_transmittance(void **state)
     umbra_context ctx = *state;
     /* Light along the view axis: no displacement, so the delta kernel reads each texel's own
      * value. Slices every 0.5 voxel; the slab is 8 voxels (16 slices) thick. */
-    const umbra_light down = directional(0.0f, -1.0f, 0.0f);
+    const umbra_light down = test_directional_light(0.0f, -1.0f, 0.0f);
     const uint32_t ks[] = {0, 1, 5, 12, 15};
     double want[5];
     for (int i = 0; i < 5; ++i)
@@ -172,7 +142,7 @@ static void test_slab_light_matches_transmittance(void **state)
      * see light from outside the view (1), and bilinear resampling spreads it a few pixels
      * further: the 14 nearest are left out. */
     const double th = 30.0 * 3.14159265358979 / 180.0;
-    const umbra_light oblique = directional((float)sin(th), (float)-cos(th), 0.0f);
+    const umbra_light oblique = test_directional_light((float)sin(th), (float)-cos(th), 0.0f);
     const uint32_t ko[] = {4, 15};
     double want_o[2];
     for (int i = 0; i < 2; ++i)
@@ -203,13 +173,13 @@ static void test_convolution_preserves_constant_light(void **state)
         for (int y = 0; y < NY; ++y)
             for (int x = 0; x < N; ++x)
                 data[((size_t)z * NY + y) * N + x] = y >= NY - 6 ? 1.0f : 0.0f;
-    umbra_volume v = make_volume(ctx, N, NY, N, data);
+    umbra_volume v = test_volume(ctx, N, NY, N, data);
     free(data);
     float t[8] = {0.8f, 0.8f, 0.8f, 0.0f, 0.8f, 0.8f, 0.8f, 0.05f};
     umbra_transfer_function tf = NULL;
     assert_int_equal(umbra_transfer_function_create(ctx, t, 2, &tf), UMBRA_SUCCESS);
     umbra_camera cam = camera_down(40.0f, 40.0f); /* 0.625 voxel per pixel */
-    umbra_light light = directional(0.15f, -1.0f, 0.1f);
+    umbra_light light = test_directional_light(0.15f, -1.0f, 0.1f);
     umbra_renderer r = make_renderer(ctx, v, tf, &cam, &light, NULL);
     set_convolution(r, 1.0f, 0, 0, 20.0f);
     float *after = malloc((size_t)IMG * IMG * 3 * sizeof *after);
@@ -367,7 +337,7 @@ static void test_compositing_matches_raycaster(void **state)
     umbra_transfer_function none = NULL;
     assert_int_equal(umbra_transfer_function_create(ctx, clear, 2, &none), UMBRA_SUCCESS);
     umbra_camera cam = camera_down(40.0f, 70.0f); /* the ground shows around the box */
-    umbra_light light = directional(0.2f, -1.0f, 0.1f);
+    umbra_light light = test_directional_light(0.2f, -1.0f, 0.1f);
     enum { W = 64, H = 48 };
     float *a = malloc(W * H * 4 * sizeof *a), *b = malloc(W * H * 4 * sizeof *b);
     assert_non_null(a);
@@ -411,7 +381,7 @@ static void test_ground_shadow_under_slab(void **state)
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "slab", 32, &sc), UMBRA_SUCCESS); /* 32 x 8 x 32 */
     umbra_camera cam = camera_down(30.0f, 48.0f);
-    umbra_light light = directional(0.0f, -1.0f, 0.0f);
+    umbra_light light = test_directional_light(0.0f, -1.0f, 0.0f);
     umbra_render_desc o = sc.options;
     o.transmission = UMBRA_TRANSMISSION_GREY;
     umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
@@ -463,7 +433,7 @@ static void test_close_to_exact_reference(void **state)
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &sc), UMBRA_SUCCESS);
     enum { W = 48, H = 48 };
-    umbra_light light = directional(-0.3f, -1.0f, -0.6f);
+    umbra_light light = test_directional_light(-0.3f, -1.0f, -0.6f);
     umbra_render_desc o = sc.options;
     o.shading = 1;
     umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &sc.camera, &light, &o);
@@ -501,7 +471,7 @@ static void test_subsamples_and_preintegration_reduce_error(void **state)
     enum { W = 48, H = 48 };
     const float dir[3] = {0.3f, 0.8f, 1.0f};
     umbra_camera cam = umbra_camera_orbit(dir, sqrtf(3.0f) * 32.0f, 30.0f);
-    umbra_light light = directional(-0.2f, -0.9f, -0.6f);
+    umbra_light light = test_directional_light(-0.2f, -0.9f, -0.6f);
     umbra_render_desc o = sc.options;
     o.ground_plane = 0;
     o.shading = 0; /* gradient shading at a slice's sample is not what the variants change */
@@ -558,7 +528,7 @@ static void test_preintegrated_raycaster(void **state)
     umbra_transfer_function ctf = test_constant_tf(ctx, 0.6f, 0.08f);
     const float dir[3] = {0.4f, 0.7f, 1.0f};
     umbra_camera cam = umbra_camera_orbit(dir, 28.0f, 30.0f);
-    umbra_light light = directional(-0.4f, -1.0f, -0.2f);
+    umbra_light light = test_directional_light(-0.4f, -1.0f, -0.2f);
     umbra_renderer r = make_renderer(ctx, cv, ctf, &cam, &light, NULL);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, a), UMBRA_SUCCESS);
@@ -608,14 +578,14 @@ static void test_unsupported_lights_and_bad_parameters(void **state)
     umbra_volume v = test_constant_volume(ctx, 16, 16, 16, 0.5f);
     umbra_transfer_function tf = test_constant_tf(ctx, 0.5f, 0.05f);
     umbra_camera cam = camera_down(30.0f, 20.0f);
-    umbra_light up = directional(0.0f, 1.0f, 0.0f); /* towards the viewer */
+    umbra_light up = test_directional_light(0.0f, 1.0f, 0.0f); /* towards the viewer */
     umbra_renderer r = make_renderer(ctx, v, tf, &cam, &up, NULL);
     set_convolution(r, 1.0f, 0, 0, 5.0f);
     float img[16 * 16 * 4];
     assert_int_equal(umbra_renderer_render(r, 16, 16, img), UMBRA_ERROR_UNSUPPORTED);
     assert_true(test_message_contains(ctx, "180.0 degrees"));
     assert_true(test_message_contains(ctx, "(0, 1, 0)"));
-    umbra_light grazing = directional(1.0f, -0.1f, 0.0f); /* 84 degrees off the view axis */
+    umbra_light grazing = test_directional_light(1.0f, -0.1f, 0.0f); /* 84 degrees off the view axis */
     assert_int_equal(umbra_renderer_set_light(r, &grazing), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, 16, 16, img), UMBRA_ERROR_UNSUPPORTED);
     assert_true(test_message_contains(ctx, "84.3 degrees"));
@@ -661,18 +631,6 @@ static void test_unsupported_lights_and_bad_parameters(void **state)
 
 /* ---- main ---------------------------------------------------------------------------------------- */
 
-static int group_setup(void **state)
-{
-    *state = test_context();
-    return *state ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    umbra_context_release(*state);
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -689,5 +647,5 @@ int main(int argc, char **argv)
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -55,28 +55,6 @@ static umbra_volume make_volume(umbra_context ctx, uint32_t n, field_fn f)
     return v;
 }
 
-static umbra_light dir_light(float x, float y, float z)
-{
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
-}
-
-static umbra_light point_light(float x, float y, float z)
-{
-    umbra_light l = dir_light(0.0f, -1.0f, 0.0f);
-    l.type = UMBRA_LIGHT_POINT;
-    l.position[0] = x;
-    l.position[1] = y;
-    l.position[2] = z;
-    return l;
-}
-
 static umbra_renderer make_renderer(umbra_context ctx, umbra_volume vol, umbra_transfer_function tf,
                                     umbra_light light, umbra_transmission transmission)
 {
@@ -253,7 +231,7 @@ static void test_slab_visibility_within_epsilon_of_exp(void **state)
     const double half = 16.0, a = 0.2, sigma = -log(1.0 - a);
     umbra_volume vol = test_constant_volume(ctx, n, n, n, 0.5f);
     umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, (float)a);
-    umbra_renderer r = make_renderer(ctx, vol, tf, dir_light(0.35f, -1.0f, 0.25f),
+    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.35f, -1.0f, 0.25f),
                                      UMBRA_TRANSMISSION_GREY);
     struct {
         umbra_light light;
@@ -261,13 +239,13 @@ static void test_slab_visibility_within_epsilon_of_exp(void **state)
         int lut;
         uint32_t prefilter;
     } cases[] = {
-        {dir_light(0.35f, -1.0f, 0.25f), 0.02f, 1, 1},
-        {dir_light(0.35f, -1.0f, 0.25f), 0.06f, 1, 1},
-        {dir_light(0.35f, -1.0f, 0.25f), 0.005f, 1, 1},
-        {dir_light(0.35f, -1.0f, 0.25f), 0.02f, 1, 5},
-        {dir_light(0.0f, -1.0f, 0.0f), 0.02f, 1, 5},
-        {dir_light(-0.8f, -0.3f, 0.6f), 0.02f, 0, 1},
-        {dir_light(0.35f, -1.0f, 0.25f), 0.02f, 0, 5},
+        {test_directional_light(0.35f, -1.0f, 0.25f), 0.02f, 1, 1},
+        {test_directional_light(0.35f, -1.0f, 0.25f), 0.06f, 1, 1},
+        {test_directional_light(0.35f, -1.0f, 0.25f), 0.005f, 1, 1},
+        {test_directional_light(0.35f, -1.0f, 0.25f), 0.02f, 1, 5},
+        {test_directional_light(0.0f, -1.0f, 0.0f), 0.02f, 1, 5},
+        {test_directional_light(-0.8f, -0.3f, 0.6f), 0.02f, 0, 1},
+        {test_directional_light(0.35f, -1.0f, 0.25f), 0.02f, 0, 5},
     };
     const uint32_t map = 64;
     const float h = 0.5f;
@@ -356,7 +334,7 @@ static void test_step_tf_lookup_table_prevents_self_shadowing(void **state)
     const uint32_t map = 64;
     umbra_volume vol = make_volume(ctx, 48, field_sphere);
     umbra_transfer_function tf = grey_tf(ctx, alpha_step);
-    umbra_renderer r = make_renderer(ctx, vol, tf, dir_light(0.3f, -1.0f, 0.2f),
+    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.3f, -1.0f, 0.2f),
                                      UMBRA_TRANSMISSION_GREY);
     float *front = malloc((size_t)map * map * 3 * sizeof *front);
     float *inside = malloc((size_t)map * map * 3 * sizeof *inside);
@@ -495,7 +473,7 @@ static void test_block_allocator_layout_and_pool_growth(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 40, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, dir_light(0.3f, -1.0f, 0.4f),
+    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.4f),
                                      UMBRA_TRANSMISSION_COLORED);
     const uint32_t map = 72; /* not a multiple of the tile: the last tiles are partial */
     umbra_shadow_desc d = deep_desc(map, 0.5f, 0.01f, 1, 1, 0);
@@ -580,7 +558,7 @@ static void test_fixed_budget_memory_and_error(void **state)
     const uint32_t map = 64, npts = 4000;
     umbra_volume vol = make_volume(ctx, 40, field_layers);
     umbra_transfer_function tf = grey_tf(ctx, alpha_ramp);
-    umbra_renderer r = make_renderer(ctx, vol, tf, dir_light(0.2f, -1.0f, 0.3f),
+    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.2f, -1.0f, 0.3f),
                                      UMBRA_TRANSMISSION_GREY);
     float *pts = malloc(npts * 3 * sizeof *pts), *ref = malloc(npts * 3 * sizeof *ref),
           *got = malloc(npts * 3 * sizeof *got);
@@ -655,17 +633,17 @@ static void test_extreme_lights_finite_and_close_to_reference(void **state)
         umbra_light light;
         double bound;
     } cases[] = {
-        {"axis -y", dir_light(0.0f, -1.0f, 0.0f), 0.008},
-        {"axis +x", dir_light(1.0f, 0.0f, 0.0f), 0.008},
-        {"axis -z", dir_light(0.0f, 0.0f, -1.0f), 0.008},
-        {"grazing", dir_light(1.0f, 1e-4f, 0.0f), 0.008},
-        {"diagonal", dir_light(1.0f, -1.0f, 1.0f), 0.008},
-        {"point on face", point_light(hx, 0.0f, 0.0f), 0.015},
-        {"point on corner", point_light(hx, hy, hz), 0.015},
-        {"point at centre", point_light(0.0f, 0.0f, 0.0f), 0.015},
-        {"point inside", point_light(0.3f * hx, -0.6f * hy, 0.2f * hz), 0.015},
-        {"point near", point_light(1.1f * hx, 1.2f * hy, 0.0f), 0.015},
-        {"point far", point_light(0.5f * hx, 6.0f * hy, 1.0f * hz), 0.008},
+        {"axis -y", test_directional_light(0.0f, -1.0f, 0.0f), 0.008},
+        {"axis +x", test_directional_light(1.0f, 0.0f, 0.0f), 0.008},
+        {"axis -z", test_directional_light(0.0f, 0.0f, -1.0f), 0.008},
+        {"grazing", test_directional_light(1.0f, 1e-4f, 0.0f), 0.008},
+        {"diagonal", test_directional_light(1.0f, -1.0f, 1.0f), 0.008},
+        {"point on face", test_point_light(hx, 0.0f, 0.0f), 0.015},
+        {"point on corner", test_point_light(hx, hy, hz), 0.015},
+        {"point at centre", test_point_light(0.0f, 0.0f, 0.0f), 0.015},
+        {"point inside", test_point_light(0.3f * hx, -0.6f * hy, 0.2f * hz), 0.015},
+        {"point near", test_point_light(1.1f * hx, 1.2f * hy, 0.0f), 0.015},
+        {"point far", test_point_light(0.5f * hx, 6.0f * hy, 1.0f * hz), 0.008},
     };
     umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, cases[0].light,
                                      UMBRA_TRANSMISSION_COLORED);
@@ -770,7 +748,7 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, dir_light(0.3f, -1.0f, 0.2f),
+    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.2f),
                                      UMBRA_TRANSMISSION_COLORED);
     set_shadow(r, deep_desc(64, 0.5f, 0.02f, 1, 1, 0));
     float img[32 * 32 * 4];
@@ -796,7 +774,7 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
     assert_int_equal(b.builds, 1);
 
     /* Light move, then a new epsilon: the map is rebuilt, the table is not. */
-    umbra_light l = dir_light(-0.5f, -1.0f, 0.1f);
+    umbra_light l = test_directional_light(-0.5f, -1.0f, 0.1f);
     assert_int_equal(umbra_renderer_set_light(r, &l), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, 32, 32, img), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_get_stats(r, &s), UMBRA_SUCCESS);
@@ -833,7 +811,7 @@ static void test_bad_parameters(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, dir_light(0.0f, -1.0f, 0.0f),
+    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.0f, -1.0f, 0.0f),
                                      UMBRA_TRANSMISSION_GREY);
     struct {
         umbra_shadow_desc d;
@@ -864,18 +842,6 @@ static void test_bad_parameters(void **state)
     umbra_scene_release(&sc);
 }
 
-static int group_setup(void **state)
-{
-    *state = test_context();
-    return *state ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    umbra_context_release(*state);
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -890,5 +856,5 @@ int main(int argc, char **argv)
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

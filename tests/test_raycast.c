@@ -104,28 +104,6 @@ static void toward_light(const umbra_light *l, const double p[3], double dir[3],
     }
 }
 
-static umbra_light directional(float x, float y, float z)
-{
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
-}
-
-static umbra_light point_light(float x, float y, float z)
-{
-    umbra_light l = directional(0.0f, -1.0f, 0.0f);
-    l.type = UMBRA_LIGHT_POINT;
-    l.position[0] = x;
-    l.position[1] = y;
-    l.position[2] = z;
-    return l;
-}
-
 static void set_reference(umbra_renderer r, float step_voxels)
 {
     umbra_shadow_desc s;
@@ -213,15 +191,15 @@ static void test_reference_slab_matches_exp(void **state)
         for (int c = 0; c < 3; ++c)
             half[c] = 0.5 * dims[c] * spacings[s][c];
         const umbra_light lights[] = {
-            directional(0.0f, -1.0f, 0.0f),      /* axis-aligned */
-            directional(1.0f, 0.0f, 0.0f),
-            directional(0.0f, 0.0f, -1.0f),
-            directional(0.3f, -0.8f, 0.5f),      /* oblique */
-            directional(-0.6f, 0.55f, -0.58f),
-            directional(1.0f, -0.003f, 0.02f),   /* grazing: almost parallel to the top face */
-            directional(0.002f, 0.01f, 1.0f),    /* grazing the x and y faces */
-            point_light((float)(2.5 * half[0]), (float)(3.0 * half[1]), (float)(-1.7 * half[2])),
-            point_light(0.0f, (float)(half[1] + 1.5), 0.0f), /* just above the top face */
+            test_directional_light(0.0f, -1.0f, 0.0f),      /* axis-aligned */
+            test_directional_light(1.0f, 0.0f, 0.0f),
+            test_directional_light(0.0f, 0.0f, -1.0f),
+            test_directional_light(0.3f, -0.8f, 0.5f),      /* oblique */
+            test_directional_light(-0.6f, 0.55f, -0.58f),
+            test_directional_light(1.0f, -0.003f, 0.02f),   /* grazing: almost parallel to the top face */
+            test_directional_light(0.002f, 0.01f, 1.0f),    /* grazing the x and y faces */
+            test_point_light((float)(2.5 * half[0]), (float)(3.0 * half[1]), (float)(-1.7 * half[2])),
+            test_point_light(0.0f, (float)(half[1] + 1.5), 0.0f), /* just above the top face */
         };
         static const char *const names[] = {"dir -y", "dir +x", "dir -z", "dir oblique",
                                             "dir oblique 2", "dir grazing top", "dir grazing z",
@@ -286,8 +264,8 @@ static void test_reference_extreme_opacity_long_path(void **state)
     const float spacing[3] = {1.0f, 1.0f, 1.0f};
     const float grey[3] = {0.5f, 0.5f, 0.5f};
     const float alphas[] = {0.999f, 0.9f, 1e-3f, 1e-4f, 1e-5f};
-    const umbra_light lights[] = {directional(0.0f, 0.0f, -1.0f),     /* along the long axis */
-                                  directional(0.004f, 0.003f, -1.0f)}; /* oblique, stays inside */
+    const umbra_light lights[] = {test_directional_light(0.0f, 0.0f, -1.0f),     /* along the long axis */
+                                  test_directional_light(0.004f, 0.003f, -1.0f)}; /* oblique, stays inside */
     umbra_volume vol = make_constant_volume(ctx, dims, spacing, 1.0f);
     enum { N = 64 };
     float pts[3 * N], rgb[3 * N];
@@ -426,7 +404,7 @@ static void test_raycast_matches_cpu_reference(void **state)
         }
         umbra_light light = sc.light;
         if (c->point_light)
-            light = point_light(0.45f * diag, 0.9f * diag, 0.3f * diag);
+            light = test_point_light(0.45f * diag, 0.9f * diag, 0.3f * diag);
         umbra_render_desc o = sc.options;
         o.shading = c->shading;
         o.ground_plane = c->ground;
@@ -801,9 +779,9 @@ static void test_bad_inputs(void **state)
     bad_cam.projection = (umbra_projection)7;
     EXPECT(umbra_renderer_set_camera(r, &bad_cam), BAD, "projection 7");
 
-    umbra_light light = directional(0.0f, 0.0f, 0.0f);
+    umbra_light light = test_directional_light(0.0f, 0.0f, 0.0f);
     EXPECT(umbra_renderer_set_light(r, &light), BAD, "(0, 0, 0)");
-    light = directional(0.0f, -1.0f, 0.0f);
+    light = test_directional_light(0.0f, -1.0f, 0.0f);
     light.color[1] = -0.5f;
     EXPECT(umbra_renderer_set_light(r, &light), BAD, "color (1, -0.5, 1)");
     light.color[1] = 1.0f;
@@ -936,18 +914,6 @@ static void test_camera_move_reuses_shadow(void **state)
 
 /* ---- main ---------------------------------------------------------------------------------------- */
 
-static int group_setup(void **state)
-{
-    *state = test_context();
-    return *state ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    umbra_context_release(*state);
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -962,5 +928,5 @@ int main(int argc, char **argv)
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -91,8 +91,8 @@ static void test_threshold_slab_crossing_matches_analytic(void **state)
     const float alpha = 0.08f, sigma = -logf(1.0f - alpha), step = 0.5f;
     umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
     umbra_transfer_function tf = mt_tf(ctx, 0.7f, 0.7f, 0.7f, alpha);
-    const umbra_light lights[] = {mt_directional(0, -1, 0), mt_directional(0.3f, -1, 0.2f),
-                                  mt_point(4, 70, -3)};
+    const umbra_light lights[] = {test_directional_light(0, -1, 0), test_directional_light(0.3f, -1, 0.2f),
+                                  test_point_light(4, 70, -3)};
     const float thresholds[] = {0.2f, 0.5f, 0.8f};
     const float target[3] = {1.3f, 0.0f, -0.7f};
     for (size_t li = 0; li < 3; ++li) {
@@ -132,7 +132,7 @@ static void test_threshold_light_transfer_function_drives_map(void **state)
     umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
     umbra_transfer_function view = mt_tf(ctx, 0.7f, 0.7f, 0.7f, a_view);
     umbra_transfer_function light = mt_tf(ctx, 0.2f, 0.2f, 0.2f, a_light);
-    umbra_light l = mt_directional(0, -1, 0);
+    umbra_light l = test_directional_light(0, -1, 0);
     umbra_renderer r = mt_renderer(ctx, vol, view, &l, UMBRA_TRANSMISSION_GREY);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 1);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);

@@ -53,14 +53,21 @@ int test_message_contains(umbra_context ctx, const char *needle)
     return 1;
 }
 
-umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
-                                  float value)
+int test_group_setup(void **state)
 {
-    size_t n = (size_t)nx * ny * nz;
-    float *data = malloc(n * sizeof *data);
-    assert_non_null(data);
-    for (size_t i = 0; i < n; ++i)
-        data[i] = value;
+    *state = test_context();
+    return *state ? 0 : -1;
+}
+
+int test_group_teardown(void **state)
+{
+    umbra_context_release(*state);
+    return 0;
+}
+
+umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                         const float *data)
+{
     umbra_volume_desc d;
     umbra_volume_desc_init(&d);
     d.data = data;
@@ -72,10 +79,43 @@ umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, u
     d.value_min = 0.0f;
     d.value_max = 1.0f;
     umbra_volume v = NULL;
-    umbra_status st = umbra_volume_create(ctx, &d, &v);
-    free(data);
-    assert_int_equal(st, UMBRA_SUCCESS);
+    assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
     return v;
+}
+
+umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                  float value)
+{
+    size_t n = (size_t)nx * ny * nz;
+    float *data = malloc(n * sizeof *data);
+    assert_non_null(data);
+    for (size_t i = 0; i < n; ++i)
+        data[i] = value;
+    umbra_volume v = test_volume(ctx, nx, ny, nz, data);
+    free(data);
+    return v;
+}
+
+umbra_light test_directional_light(float x, float y, float z)
+{
+    umbra_light l;
+    memset(&l, 0, sizeof l);
+    l.type = UMBRA_LIGHT_DIRECTIONAL;
+    l.direction[0] = x;
+    l.direction[1] = y;
+    l.direction[2] = z;
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    return l;
+}
+
+umbra_light test_point_light(float x, float y, float z)
+{
+    umbra_light l = test_directional_light(0.0f, -1.0f, 0.0f);
+    l.type = UMBRA_LIGHT_POINT;
+    l.position[0] = x;
+    l.position[1] = y;
+    l.position[2] = z;
+    return l;
 }
 
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha)

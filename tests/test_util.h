@@ -16,15 +16,31 @@
  * PoCL cache goes to the build tree when ctest sets POCL_CACHE_DIR. */
 umbra_context test_context(void);
 
+/* Group setup and teardown for cmocka_run_group_tests: a test_context() in *state, released at
+ * the end. */
+int test_group_setup(void **state);
+int test_group_teardown(void **state);
+
 /* A fresh mkdtemp directory for this process, removed at exit. */
 const char *test_tmpdir(void);
 
 /* Nonzero if the context's last error message contains needle. */
 int test_message_contains(umbra_context ctx, const char *needle);
 
+/* A float32 volume of nx x ny x nz voxels (x fastest) copied from data, unit spacing, value
+ * range [0, 1]. */
+umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                         const float *data);
+
 /* A float32 volume of dims filled with value, value range [0, 1]. */
 umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                   float value);
+
+/* A white directional light travelling along (x, y, z). */
+umbra_light test_directional_light(float x, float y, float z);
+
+/* A white point light at (x, y, z). */
+umbra_light test_point_light(float x, float y, float z);
 
 /* A grey transfer function with constant alpha (per voxel) everywhere. */
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha);
