@@ -61,6 +61,10 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         return;
     const VolGeom g = vol_geom(F);
     const uint flags = F->flags;
+    /* Frame constants the sample loop uses, read once: the compiler cannot keep them in
+     * registers itself, as the global frame might alias the buffers the kernel writes. */
+    const uint tf_size = F->tf_size;
+    const float termination = F->termination;
     float3 o, d;
     camera_ray(F, px, py, &o, &d);
 
@@ -89,52 +93,47 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         const int n = (int)ceil((t1 - t0) / h - jitter);
         /* Pre-integrated mode (preint_size != 0, kernels/preintegration.cl): sample k stands for
          * the segment [t, t + h], its colour and opacity from the table at (s(t), s(t + h)), its
-         * shading and shadow taken at the front. The back value is kept for the next segment. A
-         * segment is skipped only if both ends lie in empty bricks, and a skip stops one sample
-         * short so the segment entering a visible brick is kept. */
+         * shading and shadow taken at the front. The back value is kept for the next segment. */
         int k_back = -1;
         float s_back = 0.0f;
-        /* Samples before t_visible lie in a brick already found visible: the brick table is read
-         * once per brick crossed, not once per sample (per-sample lookups cost more than the
-         * trilinear fetch on CPUs). */
-        float t_visible = -UMBRA_INF;
-        /* Inside a visible brick the ray also jumps over its invisible sub-cells (not in
-         * pre-integrated mode, whose segments reach into the next sample's cell): the brick's
-         * cell mask and first voxel are read when the ray enters it, and like bricks a cell found
-         * visible is not tested again before t_cell, its exit. */
-        const int skip_cells = skip && !preint_size;
-        const float cell = (float)((g.brick_size + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS);
-        const float inv_cell = 1.0f / cell;
-        ulong cells = ~0UL;
-        float3 cell_origin = (float3)(0.0f);
+        /* Empty-space skipping. The ray walks the sub-cells of the brick grid (CellWalk) and
+         * takes the samples of the visible ones; a cell is tested once, when the first sample
+         * past the previous visible cell's exit (t_cell) is reached, and invisible cells are
+         * crossed without computing any sample. Pre-integrated segments reach into the next
+         * sample's cell, so that mode tests whole bricks instead: a segment is skipped only if
+         * both its ends lie in empty bricks, and a skip stops one sample short so that the
+         * segment entering a visible brick is kept; samples before t_visible lie in a brick
+         * already found visible. */
+        const int walk_cells = skip && !preint_size;
+        CellWalk w = walk_begin(g, o, d, t0);
         float t_cell = -UMBRA_INF;
+        float t_visible = -UMBRA_INF;
         for (int k = 0; k < n;) {
             float t = t0 + ((float)k + jitter) * h;
-            float3 p = o + t * d;
-            if (skip && t >= t_visible) {
-                float t_exit = brick_exit(g, o, d, t);
-                int3 b = brick_coords(g, p);
-                int bi = (b.z * g.bricks.y + b.y) * g.bricks.x + b.x;
-                if (view_bricks[bi]) {
-                    t_visible = t_exit;
-                    if (skip_cells) {
-                        cells = view_cells[bi];
-                        cell_origin = convert_float3(b * g.brick_size);
-                    }
-                } else if (!(preint_size && view_bricks[brick_index(g, p + h * d)])) {
-                    int next = next_sample_after(t0, h, jitter, t_exit, k);
-                    k = preint_size ? max(next - 1, k + 1) : next;
-                    continue;
+            if (walk_cells && t >= t_cell) {
+                const float t_in = walk_to_visible(&w, g, view_cells, t, t1);
+                if (t_in > t) {
+                    if (!(t_in < t1))
+                        break;
+                    k = next_sample_after(t0, h, jitter, t_in, k);
+                    if (k >= n)
+                        break;
+                    t = t0 + ((float)k + jitter) * h;
+                    if (!(t < walk_exit(&w)))
+                        continue; /* the visible cell holds no sample: walk on from t */
                 }
+                t_cell = walk_exit(&w);
             }
-            if (skip_cells && t >= t_cell) {
-                int3 c = cell_coords(g, cell_origin, inv_cell, p);
-                float t_exit = fmin(cell_exit(g, o, d, cell_origin, cell, c), t_visible);
-                if (!cell_visible(cells, c)) {
-                    k = next_sample_after(t0, h, jitter, t_exit, k);
+            float3 p = o + t * d;
+            if (skip && preint_size && t >= t_visible) {
+                float t_exit = brick_exit(g, o, d, t);
+                if (view_bricks[brick_index(g, p)]) {
+                    t_visible = t_exit;
+                } else if (!view_bricks[brick_index(g, p + h * d)]) {
+                    int next = next_sample_after(t0, h, jitter, t_exit, k);
+                    k = max(next - 1, k + 1);
                     continue;
                 }
-                t_cell = t_exit;
             }
             ++taken;
             float4 c;
@@ -145,7 +144,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                 c = preint_lookup(preint, preint_size, sf, s_back);
                 c.xyz = preint_color(c);
             } else {
-                c = tf_lookup(view_tf, F->tf_size, sample_volume(vol, g, p));
+                c = tf_lookup(view_tf, tf_size, sample_volume(vol, g, p));
             }
             if (c.w > 0.0f) {
                 float3 s = SHADOW_FACTOR(sr, p);
@@ -154,14 +153,14 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                 float3 lit = shade_sample(F, c.xyz, s, p, -d, grad);
                 color += (1.0f - alpha) * c.w * lit;
                 alpha += (1.0f - alpha) * c.w;
-                if (alpha > F->termination)
+                if (alpha > termination)
                     break;
             }
             ++k;
         }
     }
 
-    if (t_ground < UMBRA_INF && alpha <= F->termination) {
+    if (t_ground < UMBRA_INF && alpha <= termination) {
         float3 p = o + t_ground * d;
         float3 s = SHADOW_FACTOR(sr, p);
         float ndl = fmax(dot(F3(F->ground), to_light(F, p).xyz), 0.0f);

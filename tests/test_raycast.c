@@ -5,7 +5,8 @@
  *    reference steps, on isotropic and anisotropic grids;
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
  *    pixel (<= 1e-4 per channel) and sample for sample;
- *  - empty-space skipping changes no pixel and takes fewer samples;
+ *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
+ *    edge cases (odd brick sizes, rays running in cell faces);
  *  - an application's own cl_context / device / queue work and are left as they were found;
  *  - bad inputs give the right status and a message naming the value, and the context keeps
  *    working;
@@ -513,6 +514,135 @@ static void test_empty_space_skipping_changes_no_pixel(void **state)
     free(off);
 }
 
+/* Renders with skipping on and off and, skipping on, with the plain-C twin; returns the samples
+ * taken with skipping on. The three must agree: skipping to 1e-6, the twin to 1e-4. */
+static uint64_t check_skipping(umbra_context ctx, umbra_volume vol, umbra_transfer_function tf,
+                               const umbra_camera *cam, uint32_t w, uint32_t h, const char *what)
+{
+    umbra_light light = test_directional_light(0.3f, -1.0f, 0.2f);
+    umbra_renderer r = NULL;
+    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_volume(r, vol), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_camera(r, cam), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_light(r, &light), UMBRA_SUCCESS);
+    umbra_render_desc o;
+    umbra_render_desc_init(&o);
+    o.jitter = 1;
+    o.ground_plane = 0;
+    umbra_shadow_desc sh;
+    umbra_shadow_desc_init(&sh);
+    sh.technique = UMBRA_SHADOW_NONE;
+    assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
+    float *on = malloc((size_t)w * h * 4 * sizeof *on), *off = malloc((size_t)w * h * 4 * sizeof *off);
+    float *cpu = malloc((size_t)w * h * 4 * sizeof *cpu);
+    assert_non_null(on);
+    assert_non_null(off);
+    assert_non_null(cpu);
+    umbra_render_stats s_on, s_off;
+    o.empty_space_skipping = 0;
+    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, w, h, off), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &s_off), UMBRA_SUCCESS);
+    o.empty_space_skipping = 1;
+    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, w, h, on), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &s_on), UMBRA_SUCCESS);
+    float *voxels = read_voxels(ctx, vol);
+    cpu_scene cs;
+    fill_cpu_scene(&cs, vol, voxels, tf, cam, &light, &o, &sh);
+    uint64_t cpu_samples = cpu_render(&cs, w, h, cpu);
+    size_t at, at_cpu;
+    double err = max_abs_diff(on, off, (size_t)w * h * 4, &at);
+    double err_cpu = max_abs_diff(on, cpu, (size_t)w * h * 4, &at_cpu);
+    print_message("  %-28s: on/off max |diff| %.2e, samples %llu of %llu; plain C %.2e, %llu\n",
+                  what, err, (unsigned long long)s_on.samples, (unsigned long long)s_off.samples,
+                  err_cpu, (unsigned long long)cpu_samples);
+    if (err > 1e-6)
+        fail_msg("%s: pixel (%zu, %zu) channel %zu: skipping %.7f, not skipping %.7f", what,
+                 (at / 4) % w, (at / 4) / w, at % 4, on[at], off[at]);
+    if (err_cpu > 1e-4)
+        fail_msg("%s: pixel (%zu, %zu) channel %zu: umbra %.7f, plain C %.7f", what,
+                 (at_cpu / 4) % w, (at_cpu / 4) / w, at_cpu % 4, on[at_cpu], cpu[at_cpu]);
+    assert_true(s_on.samples < s_off.samples);
+    free(voxels);
+    free(on);
+    free(off);
+    free(cpu);
+    umbra_renderer_release(r);
+    return s_on.samples;
+}
+
+/* The sub-cell walk (CellWalk) on its edge cases: brick sizes that 4 does not divide (cells of
+ * unequal size, a brick of 2 with two cells) or that exceed the volume, odd dims, one-voxel-thin
+ * features, and rays along each axis that run exactly in cell faces (odd image and dims put the
+ * orthographic pixel centres on the faces), as well as oblique and perspective rays. */
+static void test_cell_walk_edge_cases(void **state)
+{
+    umbra_context ctx = *state;
+    enum { NX = 37, NY = 29, NZ = 25, W = 47 };
+    float *data = calloc((size_t)NX * NY * NZ, sizeof *data);
+    assert_non_null(data);
+    for (int z = 0; z < NZ; ++z)
+        for (int y = 0; y < NY; ++y)
+            for (int x = 0; x < NX; ++x) {
+                float v = 0.0f;
+                int dx = x - 10, dy = y - 8, dz = z - 6;
+                if (dx * dx + dy * dy + dz * dz < 10)
+                    v = 1.0f; /* a ball */
+                if (x == 21 && y > 4 && y < 20)
+                    v = 0.6f; /* a one-voxel sheet */
+                if (x >= 28 && x <= 30 && y >= 22 && z >= 17 && z <= 19)
+                    v = 0.8f; /* a bar reaching the +y face */
+                if (x == NX - 1 && y == 3 && z == NZ - 1)
+                    v = 1.0f; /* a corner voxel */
+                data[((size_t)z * NY + y) * NX + x] = v;
+            }
+    /* Transparent up to value 1/3, then rising: values 0.6 to 1 are visible. */
+    const float table[16] = {0.2f, 0.3f, 0.9f, 0.0f, 0.4f, 0.8f, 0.2f, 0.0f,
+                             0.9f, 0.5f, 0.1f, 0.3f, 1.0f, 1.0f, 0.8f, 0.6f};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create(ctx, table, 4, &tf), UMBRA_SUCCESS);
+    static const uint32_t brick_sizes[] = {2, 3, 5, 10, 16, 64};
+    for (size_t b = 0; b < sizeof brick_sizes / sizeof brick_sizes[0]; ++b) {
+        umbra_volume_desc d;
+        umbra_volume_desc_init(&d);
+        d.data = data;
+        d.type = UMBRA_FLOAT32;
+        d.dims[0] = NX;
+        d.dims[1] = NY;
+        d.dims[2] = NZ;
+        d.value_range_given = 1;
+        d.value_min = 0.0f;
+        d.value_max = 1.0f;
+        d.brick_size = brick_sizes[b];
+        umbra_volume vol = NULL;
+        assert_int_equal(umbra_volume_create(ctx, &d, &vol), UMBRA_SUCCESS);
+        /* Along +x, -y, +z, with pixel centres on integer world coordinates: the cell faces. */
+        static const float axes[3][3] = {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}};
+        for (int a = 0; a < 3; ++a) {
+            umbra_camera cam;
+            memset(&cam, 0, sizeof cam);
+            cam.projection = UMBRA_ORTHOGRAPHIC;
+            for (int i = 0; i < 3; ++i)
+                cam.eye[i] = -60.0f * axes[a][i];
+            cam.up[a == 1 ? 2 : 1] = 1.0f;
+            cam.ortho_height = (float)W;
+            char what[64];
+            snprintf(what, sizeof what, "brick %u, along axis %d", brick_sizes[b], a);
+            check_skipping(ctx, vol, tf, &cam, W, W, what);
+        }
+        const float dir[3] = {0.45f, -0.7f, 0.55f};
+        umbra_camera cam = umbra_camera_orbit(dir, 52.0f, 35.0f);
+        char what[64];
+        snprintf(what, sizeof what, "brick %u, perspective", brick_sizes[b]);
+        check_skipping(ctx, vol, tf, &cam, 40, 36, what);
+        umbra_volume_release(vol);
+    }
+    umbra_transfer_function_release(tf);
+    free(data);
+}
+
 /* ---- the application's own OpenCL objects ------------------------------------------------------ */
 
 /* PoCL's CPU device (the one test_context uses), found without umbra. */
@@ -921,6 +1051,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_reference_extreme_opacity_long_path),
         cmocka_unit_test(test_raycast_matches_cpu_reference),
         cmocka_unit_test(test_empty_space_skipping_changes_no_pixel),
+        cmocka_unit_test(test_cell_walk_edge_cases),
         cmocka_unit_test(test_application_context_path),
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_sampler_backends_agree),

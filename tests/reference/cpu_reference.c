@@ -31,7 +31,7 @@ typedef struct prep {
     float voxel;                  /* world length of one voxel step: the smallest spacing */
     float *view_tf, *light_tf;    /* alpha corrected for the view step / the shadow step */
     int view_n, light_n;
-    unsigned char *view_bricks, *light_bricks;
+    unsigned char *light_bricks;  /* per brick, visible to the light transfer function */
     uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
     int nb[3], B;
     float step, shadow_step;
@@ -161,36 +161,137 @@ static uint64_t *cells(const prep *P, const float *tf, int n)
     return out;
 }
 
-/* The sub-cell of p in brick b (the kernels' cell_coords); returns its bit in the brick's mask. */
-static int cell_of(const prep *P, const int b[3], v3 p, int c[3])
+/* The view ray's walk over the bricks' sub-cells (the kernels' CellWalk, kernels/common.cl): a
+ * 3D DDA in voxel coordinates; along each axis brick b's cell j covers [b B + j C,
+ * b B + min((j + 1) C, B)), the border cells reaching on to infinity. */
+typedef struct walk {
+    float xo[3], xd[3], inv[3]; /* the ray in voxel coordinates, 1 / its direction */
+    int dir[3], b[3], c[3];  /* direction signs; the current cell's brick and index in it */
+    float face[3];           /* parameter at which the ray leaves the cell through each axis */
+    float t_in;              /* and at which it entered it */
+} walk;
+
+static float walk_face(const prep *P, const walk *w, int a)
 {
-    const float inv_cell = 1.0f / (float)((P->B + CELLS - 1) / CELLS);
-    float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
-                  (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
-                  (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
-    for (int a = 0; a < 3; ++a) {
-        int i = (int)floorf((x[a] - (float)(b[a] * P->B)) * inv_cell);
-        c[a] = i < 0 ? 0 : (i > CELLS - 1 ? CELLS - 1 : i);
+    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    if (w->dir[a] > 0) {
+        int hi = (w->c[a] + 1) * C < B ? (w->c[a] + 1) * C : B;
+        return (w->b[a] == P->nb[a] - 1 && hi == B) ? INFINITY
+                                                     : ((float)(w->b[a] * B + hi) - w->xo[a]) * w->inv[a];
     }
-    return (c[2] * CELLS + c[1]) * CELLS + c[0];
+    if (w->dir[a] < 0)
+        return (w->b[a] == 0 && w->c[a] == 0) ? INFINITY
+                                               : ((float)(w->b[a] * B + w->c[a] * C) - w->xo[a]) * w->inv[a];
+    return INFINITY;
 }
 
-/* Ray parameter where o + t d leaves sub-cell c of brick b (the kernels' cell_exit). */
-static float cell_exit(const prep *P, v3 o, v3 d, const int b[3], const int c[3])
+/* The cell of the current brick holding voxel position x along axis a, clamped into the brick. */
+static int walk_cell_at(const prep *P, const walk *w, int a, float x)
 {
-    const float cell = (float)((P->B + CELLS - 1) / CELLS);
+    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    int c = (int)floorf((x - (float)(w->b[a] * B)) / (float)C);
+    return c < 0 ? 0 : (c > (B - 1) / C ? (B - 1) / C : c);
+}
+
+static void walk_begin(const prep *P, walk *w, v3 o, v3 d, float t)
+{
+    const int B = P->B;
     float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
-    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, sp[3] = {P->spacing.x, P->spacing.y, P->spacing.z};
-    float t = INFINITY;
+    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z};
+    float is[3] = {P->inv_spacing.x, P->inv_spacing.y, P->inv_spacing.z};
     for (int a = 0; a < 3; ++a) {
-        float lo = ((float)(b[a] * P->B) + (float)c[a] * cell + 0.5f) * sp[a] + bmin[a];
-        float hi = lo + cell * sp[a];
-        if (dd[a] > 0.0f)
-            t = fminf(t, (hi - oo[a]) / dd[a]);
-        else if (dd[a] < 0.0f)
-            t = fminf(t, (lo - oo[a]) / dd[a]);
+        float xd = dd[a] * is[a];
+        w->xo[a] = (oo[a] - bmin[a]) * is[a] - 0.5f;
+        w->xd[a] = xd;
+        w->inv[a] = 1.0f / xd;
+        w->dir[a] = xd > 0.0f ? 1 : (xd < 0.0f ? -1 : 0);
+        float x = w->xo[a] + t * xd;
+        int b = (int)floorf(x / (float)B);
+        w->b[a] = b < 0 ? 0 : (b > P->nb[a] - 1 ? P->nb[a] - 1 : b);
+        w->c[a] = walk_cell_at(P, w, a, x);
     }
-    return t;
+    for (int a = 0; a < 3; ++a)
+        w->face[a] = walk_face(P, w, a);
+    w->t_in = t;
+}
+
+static float walk_exit(const walk *w)
+{
+    return fminf(fminf(w->face[0], w->face[1]), w->face[2]);
+}
+
+static void walk_advance(const prep *P, walk *w)
+{
+    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    int a = w->face[0] <= w->face[1] && w->face[0] <= w->face[2] ? 0 : (w->face[1] <= w->face[2] ? 1 : 2);
+    w->t_in = walk_exit(w);
+    if (w->dir[a] > 0) {
+        if (((w->c[a] + 1) * C < B ? (w->c[a] + 1) * C : B) == B) {
+            ++w->b[a];
+            w->c[a] = 0;
+        } else {
+            ++w->c[a];
+        }
+    } else if (w->c[a] == 0) {
+        --w->b[a];
+        w->c[a] = (B - 1) / C;
+    } else {
+        --w->c[a];
+    }
+    w->face[a] = walk_face(P, w, a);
+}
+
+/* Moves the walk out of the current brick, all of whose cells are invisible, into the cell of
+ * the next brick where the ray enters it (the kernels' walk_skip_brick); t_in = infinity when
+ * the ray leaves the grid. */
+static void walk_skip_brick(const prep *P, walk *w)
+{
+    const int B = P->B, C = (B + CELLS - 1) / CELLS, last = (B - 1) / C;
+    float tb[3];
+    for (int a = 0; a < 3; ++a) {
+        tb[a] = INFINITY;
+        if (w->dir[a] > 0 && w->b[a] < P->nb[a] - 1)
+            tb[a] = ((float)((w->b[a] + 1) * B) - w->xo[a]) * w->inv[a];
+        if (w->dir[a] < 0 && w->b[a] > 0)
+            tb[a] = ((float)(w->b[a] * B) - w->xo[a]) * w->inv[a];
+    }
+    float t = fminf(fminf(tb[0], tb[1]), tb[2]);
+    if (!(t < INFINITY)) {
+        w->t_in = INFINITY;
+        return;
+    }
+    for (int a = 0; a < 3; ++a)
+        w->c[a] = walk_cell_at(P, w, a, w->xo[a] + t * w->xd[a]);
+    int e = tb[0] <= tb[1] && tb[0] <= tb[2] ? 0 : (tb[1] <= tb[2] ? 1 : 2);
+    w->b[e] += w->dir[e];
+    w->c[e] = w->dir[e] > 0 ? 0 : last;
+    for (int a = 0; a < 3; ++a)
+        w->face[a] = walk_face(P, w, a);
+    w->t_in = t;
+}
+
+/* Walks on to the first visible cell that the ray leaves after t; returns where the ray entered
+ * it (at most t if t lies in it), or infinity if none begins before t_end. */
+static float walk_to_visible(const prep *P, walk *w, float t, float t_end)
+{
+    for (;;) {
+        if (!(w->t_in < t_end))
+            return INFINITY;
+        uint64_t mask = P->view_cells[(w->b[2] * P->nb[1] + w->b[1]) * P->nb[0] + w->b[0]];
+        if (!mask) {
+            walk_skip_brick(P, w);
+            continue;
+        }
+        float t_out = walk_exit(w);
+        if (t_out > t) {
+            int bit = (w->c[2] * CELLS + w->c[1]) * CELLS + w->c[0];
+            if ((mask >> bit) & 1u)
+                return w->t_in;
+        }
+        if (!(t_out < INFINITY))
+            return INFINITY;
+        walk_advance(P, w);
+    }
 }
 
 static void prep_init(prep *P, const cpu_scene *s)
@@ -213,7 +314,6 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->view_n = s->tf_count;
     P->view_tf = corrected(s->tf, s->tf_count, s->opts.step);
     P->light_tf = corrected(ltf, P->light_n, s->reference_step);
-    P->view_bricks = bricks(P, s->tf, s->tf_count);
     P->view_cells = cells(P, s->tf, s->tf_count);
     P->light_bricks = bricks(P, ltf, P->light_n);
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
@@ -225,7 +325,6 @@ static void prep_free(prep *P)
 {
     free(P->view_tf);
     free(P->light_tf);
-    free(P->view_bricks);
     free(P->view_cells);
     free(P->light_bricks);
 }
@@ -433,35 +532,27 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
         if (t1 > t0) {
             const float hstep = P->step;
             float jitter = o->jitter ? random01(o->seed, (uint32_t)px, (uint32_t)py, 0u) : 0.0f;
-            int n = (int)ceilf((t1 - t0) / hstep - jitter), b[3];
-            float t_visible = -INFINITY; /* samples before it lie in a brick found visible */
-            uint64_t mask = ~(uint64_t)0;  /* that brick's visible sub-cells */
-            float t_cell = -INFINITY;     /* samples before it lie in a sub-cell found visible */
-            int cb[3] = {0, 0, 0};        /* and its grid coordinates */
+            int n = (int)ceilf((t1 - t0) / hstep - jitter);
+            walk w;
+            walk_begin(P, &w, org, d, t0);
+            float t_cell = -INFINITY; /* samples before it lie in a visible cell */
             for (int k = 0; k < n;) {
                 float t = t0 + ((float)k + jitter) * hstep;
-                v3 p = add(org, mul(d, t));
-                if (o->empty_space_skipping && t >= t_visible) {
-                    float t_exit = brick_exit(P, org, d, t);
-                    int bi = brick_of(P, p, b);
-                    if (!P->view_bricks[bi]) {
-                        k = next_after(t0, hstep, jitter, t_exit, k);
-                        continue;
-                    }
-                    t_visible = t_exit;
-                    mask = P->view_cells[bi];
-                    memcpy(cb, b, sizeof cb);
-                }
                 if (o->empty_space_skipping && t >= t_cell) {
-                    int c3[3];
-                    int bit = cell_of(P, cb, p, c3);
-                    float te = fminf(cell_exit(P, org, d, cb, c3), t_visible);
-                    if (!((mask >> bit) & 1u)) {
-                        k = next_after(t0, hstep, jitter, te, k);
-                        continue;
+                    float t_in = walk_to_visible(P, &w, t, t1);
+                    if (t_in > t) {
+                        if (!(t_in < t1))
+                            break;
+                        k = next_after(t0, hstep, jitter, t_in, k);
+                        if (k >= n)
+                            break;
+                        t = t0 + ((float)k + jitter) * hstep;
+                        if (!(t < walk_exit(&w)))
+                            continue;
                     }
-                    t_cell = te;
+                    t_cell = walk_exit(&w);
                 }
+                v3 p = add(org, mul(d, t));
                 ++taken;
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
                 if (c[3] > 0.0f) {
@@ -521,7 +612,7 @@ cpu_prepared *cpu_prepare(const cpu_scene *s)
     if (!p)
         return NULL;
     prep_init(&p->P, s);
-    if (!p->P.view_tf || !p->P.light_tf || !p->P.view_bricks || !p->P.light_bricks ||
+    if (!p->P.view_tf || !p->P.light_tf || !p->P.light_bricks ||
         !p->P.view_cells) {
         cpu_prepared_free(p);
         return NULL;
