@@ -61,8 +61,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         return;
     const VolGeom g = vol_geom(F);
     const uint flags = F->flags;
-    /* Frame constants the sample loop uses, read once: the compiler cannot keep them in
-     * registers itself, as the global frame might alias the buffers the kernel writes. */
+    /* Frame constants the sample loop uses, read from the global frame once. */
     const uint tf_size = F->tf_size;
     const float termination = F->termination;
     float3 o, d;
