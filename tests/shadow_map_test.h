@@ -45,23 +45,6 @@ static inline umbra_shadow_desc mt_shadow(umbra_shadow_technique t, uint32_t map
     return s;
 }
 
-/* A renderer on volume and tf, lit by light, with default options of the given transmission. */
-static inline umbra_renderer mt_renderer(umbra_context ctx, umbra_volume volume,
-                                         umbra_transfer_function tf, const umbra_light *light,
-                                         umbra_transmission transmission)
-{
-    umbra_renderer r = NULL;
-    umbra_render_desc o;
-    umbra_render_desc_init(&o);
-    o.transmission = transmission;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, volume), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, light), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-    return r;
-}
-
 /* World point at the centre of texel (i, j) of an orthographic map, at distance `along` along the
  * light direction (the map's w axis) from the origin. The map must have been built. */
 static inline void mt_texel_point(umbra_renderer r, uint32_t i, uint32_t j, float along, float p[3])
@@ -164,7 +147,7 @@ static inline void mt_check_stress_lights(umbra_context ctx, umbra_shadow_desc s
     }
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         const umbra_light *l = &cases[c].light;
-        umbra_renderer r = mt_renderer(ctx, vol, tf, l, UMBRA_TRANSMISSION_COLORED);
+        umbra_renderer r = test_renderer_transmission(ctx, vol, tf, *l, UMBRA_TRANSMISSION_COLORED);
         assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_set_camera(r, &camera), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
@@ -240,7 +223,7 @@ static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_des
 {
     umbra_scene scene;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &scene), UMBRA_SUCCESS);
-    umbra_renderer r = mt_renderer(ctx, scene.volume, scene.tf, &scene.light,
+    umbra_renderer r = test_renderer_transmission(ctx, scene.volume, scene.tf, scene.light,
                                    UMBRA_TRANSMISSION_COLORED);
     enum { W = 32, H = 32 };
     float img[W * H * 4];
@@ -302,7 +285,7 @@ static inline double mt_error_vs_reference(umbra_context ctx, umbra_shadow_desc 
     enum { W = 96, H = 96 };
     umbra_scene scene;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 48, &scene), UMBRA_SUCCESS);
-    umbra_renderer r = mt_renderer(ctx, scene.volume, scene.tf, &scene.light,
+    umbra_renderer r = test_renderer_transmission(ctx, scene.volume, scene.tf, scene.light,
                                    scene.options.transmission);
     assert_int_equal(umbra_renderer_set_options(r, &scene.options), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_set_camera(r, &scene.camera), UMBRA_SUCCESS);

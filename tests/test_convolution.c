@@ -56,21 +56,6 @@ static void set_convolution(umbra_renderer r, float dz, uint32_t n, int pi, floa
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
 }
 
-static umbra_renderer make_renderer(umbra_context ctx, umbra_volume v, umbra_transfer_function tf,
-                                    const umbra_camera *cam, const umbra_light *light,
-                                    const umbra_render_desc *opts)
-{
-    umbra_renderer r = NULL;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, v), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_camera(r, cam), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, light), UMBRA_SUCCESS);
-    if (opts)
-        assert_int_equal(umbra_renderer_set_options(r, opts), UMBRA_SUCCESS);
-    return r;
-}
-
 static double mean_abs_diff(const float *a, const float *b, size_t pixels)
 {
     double sum = 0.0;
@@ -100,7 +85,7 @@ static void slab_light(umbra_context ctx, const umbra_light *light, int variant,
     free(data);
     umbra_transfer_function tf = test_constant_tf(ctx, 0.7f, 0.03f);
     umbra_camera cam = camera_down(20.0f, 16.0f);
-    umbra_renderer r = make_renderer(ctx, v, tf, &cam, light, NULL);
+    umbra_renderer r = test_renderer(ctx, v, tf, &cam, light, NULL);
     set_convolution(r, dz, (variant & 2) ? 2 : 0, variant & 1, 0.0f);
     float *rgb = malloc((size_t)SLAB_IMG * SLAB_IMG * 3 * sizeof *rgb);
     assert_non_null(rgb);
@@ -180,7 +165,7 @@ static void test_convolution_preserves_constant_light(void **state)
     assert_int_equal(umbra_transfer_function_create(ctx, t, 2, &tf), UMBRA_SUCCESS);
     umbra_camera cam = camera_down(40.0f, 40.0f); /* 0.625 voxel per pixel */
     umbra_light light = test_directional_light(0.15f, -1.0f, 0.1f);
-    umbra_renderer r = make_renderer(ctx, v, tf, &cam, &light, NULL);
+    umbra_renderer r = test_renderer(ctx, v, tf, &cam, &light, NULL);
     set_convolution(r, 1.0f, 0, 0, 20.0f);
     float *after = malloc((size_t)IMG * IMG * 3 * sizeof *after);
     float *later = malloc((size_t)IMG * IMG * 3 * sizeof *later);
@@ -351,7 +336,7 @@ static void test_compositing_matches_raycaster(void **state)
         o.background[2] = 0.3f;
         o.background[3] = 1.0f;
         o.termination = shading ? 0.95f : 1.0f;
-        umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
+        umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
         assert_int_equal(umbra_renderer_set_light_transfer_function(r, none), UMBRA_SUCCESS);
         umbra_shadow_desc s;
         umbra_shadow_desc_init(&s);
@@ -384,7 +369,7 @@ static void test_ground_shadow_under_slab(void **state)
     umbra_light light = test_directional_light(0.0f, -1.0f, 0.0f);
     umbra_render_desc o = sc.options;
     o.transmission = UMBRA_TRANSMISSION_GREY;
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
+    umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
     enum { W = 48, H = 48 };
     float *img = malloc(W * H * 4 * sizeof *img);
     assert_non_null(img);
@@ -436,7 +421,7 @@ static void test_close_to_exact_reference(void **state)
     umbra_light light = test_directional_light(-0.3f, -1.0f, -0.6f);
     umbra_render_desc o = sc.options;
     o.shading = 1;
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &sc.camera, &light, &o);
+    umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &sc.camera, &light, &o);
     float *ref = malloc(W * H * 4 * sizeof *ref), *img = malloc(W * H * 4 * sizeof *img);
     assert_non_null(ref);
     assert_non_null(img);
@@ -475,7 +460,7 @@ static void test_subsamples_and_preintegration_reduce_error(void **state)
     umbra_render_desc o = sc.options;
     o.ground_plane = 0;
     o.shading = 0; /* gradient shading at a slice's sample is not what the variants change */
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
+    umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
     float *fine = malloc(W * H * 4 * sizeof *fine), *img = malloc(W * H * 4 * sizeof *img);
     assert_non_null(fine);
     assert_non_null(img);
@@ -529,7 +514,7 @@ static void test_preintegrated_raycaster(void **state)
     const float dir[3] = {0.4f, 0.7f, 1.0f};
     umbra_camera cam = umbra_camera_orbit(dir, 28.0f, 30.0f);
     umbra_light light = test_directional_light(-0.4f, -1.0f, -0.2f);
-    umbra_renderer r = make_renderer(ctx, cv, ctf, &cam, &light, NULL);
+    umbra_renderer r = test_renderer(ctx, cv, ctf, &cam, &light, NULL);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, a), UMBRA_SUCCESS);
     s.preintegrated = 1;
@@ -550,7 +535,7 @@ static void test_preintegrated_raycaster(void **state)
     o.shading = 0; /* pre-integration fixes the opacity integral, not the shading position */
     s.technique = UMBRA_SHADOW_NONE;
     s.preintegrated = 0;
-    r = make_renderer(ctx, sc.volume, sc.tf, &sc.camera, &sc.light, &o);
+    r = test_renderer(ctx, sc.volume, sc.tf, &sc.camera, &sc.light, &o);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, fine), UMBRA_SUCCESS);
     o.step = 1.0f;
@@ -579,7 +564,7 @@ static void test_unsupported_lights_and_bad_parameters(void **state)
     umbra_transfer_function tf = test_constant_tf(ctx, 0.5f, 0.05f);
     umbra_camera cam = camera_down(30.0f, 20.0f);
     umbra_light up = test_directional_light(0.0f, 1.0f, 0.0f); /* towards the viewer */
-    umbra_renderer r = make_renderer(ctx, v, tf, &cam, &up, NULL);
+    umbra_renderer r = test_renderer(ctx, v, tf, &cam, &up, NULL);
     set_convolution(r, 1.0f, 0, 0, 5.0f);
     float img[16 * 16 * 4];
     assert_int_equal(umbra_renderer_render(r, 16, 16, img), UMBRA_ERROR_UNSUPPORTED);

@@ -72,7 +72,7 @@ static void test_cssm_slab_mean_matches_transmittance(void **state)
     umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
     umbra_transfer_function tf = mt_tf(ctx, 0.7f, 0.7f, 0.7f, a);
     umbra_light l = test_directional_light(0, -1, 0);
-    umbra_renderer r = mt_renderer(ctx, vol, tf, &l, UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(ctx, vol, tf, l, UMBRA_TRANSMISSION_GREY);
     const uint32_t taps[] = {1, 7, 13, 21};
     /* On segment boundaries (exact), inside a segment (discretised), below the slab (exact). */
     const float depths[] = {10.0f, 20.0f, 10.3f, 40.0f};
@@ -110,7 +110,7 @@ static void test_cssm_colored_channels_share_random_numbers(void **state)
     umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
     umbra_transfer_function tf = mt_tf(ctx, t[0], t[1], t[2], a);
     umbra_light l = test_directional_light(0, -1, 0);
-    umbra_renderer r = mt_renderer(ctx, vol, tf, &l, UMBRA_TRANSMISSION_COLORED);
+    umbra_renderer r = test_renderer_transmission(ctx, vol, tf, l, UMBRA_TRANSMISSION_COLORED);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_CSSM, MAP, 13);
     s.map_step = h;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
@@ -153,7 +153,7 @@ static void test_cssm_light_transfer_function_drives_generation(void **state)
     umbra_transfer_function view = mt_tf(ctx, 0.7f, 0.7f, 0.7f, a_view);
     umbra_transfer_function light = mt_tf(ctx, 0.3f, 0.3f, 0.3f, a_light);
     umbra_light l = test_directional_light(0, -1, 0);
-    umbra_renderer r = mt_renderer(ctx, vol, view, &l, UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(ctx, vol, view, l, UMBRA_TRANSMISSION_GREY);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_CSSM, MAP, 7);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     const umbra_transfer_function tfs[] = {view, light, NULL};
@@ -179,8 +179,8 @@ static void test_cssm_light_transfer_function_drives_generation(void **state)
 /* Spheres 48^3 at 64x64, 13 taps, 128^2 map. */
 static void render_spheres(umbra_scene *scene, uint32_t seed, int skip, float *img)
 {
-    umbra_renderer r = mt_renderer(ctx, scene->volume, scene->tf, &scene->light,
-                                   UMBRA_TRANSMISSION_COLORED);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, scene->volume, scene->tf, scene->light, UMBRA_TRANSMISSION_COLORED);
     umbra_render_desc o = scene->options;
     o.empty_space_skipping = skip;
     assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);

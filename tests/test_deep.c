@@ -55,21 +55,6 @@ static umbra_volume make_volume(umbra_context ctx, uint32_t n, field_fn f)
     return v;
 }
 
-static umbra_renderer make_renderer(umbra_context ctx, umbra_volume vol, umbra_transfer_function tf,
-                                    umbra_light light, umbra_transmission transmission)
-{
-    umbra_renderer r = NULL;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, vol), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, &light), UMBRA_SUCCESS);
-    umbra_render_desc o;
-    umbra_render_desc_init(&o);
-    o.transmission = transmission;
-    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-    return r;
-}
-
 static umbra_shadow_desc deep_desc(uint32_t map_size, float map_step, float eps, int lut,
                                    uint32_t prefilter, uint32_t max_nodes)
 {
@@ -231,8 +216,8 @@ static void test_slab_visibility_within_epsilon_of_exp(void **state)
     const double half = 16.0, a = 0.2, sigma = -log(1.0 - a);
     umbra_volume vol = test_constant_volume(ctx, n, n, n, 0.5f);
     umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, (float)a);
-    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.35f, -1.0f, 0.25f),
-                                     UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, vol, tf, test_directional_light(0.35f, -1.0f, 0.25f), UMBRA_TRANSMISSION_GREY);
     struct {
         umbra_light light;
         float eps;
@@ -334,8 +319,8 @@ static void test_step_tf_lookup_table_prevents_self_shadowing(void **state)
     const uint32_t map = 64;
     umbra_volume vol = make_volume(ctx, 48, field_sphere);
     umbra_transfer_function tf = grey_tf(ctx, alpha_step);
-    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.3f, -1.0f, 0.2f),
-                                     UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, vol, tf, test_directional_light(0.3f, -1.0f, 0.2f), UMBRA_TRANSMISSION_GREY);
     float *front = malloc((size_t)map * map * 3 * sizeof *front);
     float *inside = malloc((size_t)map * map * 3 * sizeof *inside);
     float *rgb = malloc((size_t)map * map * 3 * sizeof *rgb);
@@ -473,8 +458,9 @@ static void test_block_allocator_layout_and_pool_growth(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 40, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.4f),
-                                     UMBRA_TRANSMISSION_COLORED);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.4f),
+        UMBRA_TRANSMISSION_COLORED);
     const uint32_t map = 72; /* not a multiple of the tile: the last tiles are partial */
     umbra_shadow_desc d = deep_desc(map, 0.5f, 0.01f, 1, 1, 0);
     d.block_size = 2;
@@ -558,8 +544,8 @@ static void test_fixed_budget_memory_and_error(void **state)
     const uint32_t map = 64, npts = 4000;
     umbra_volume vol = make_volume(ctx, 40, field_layers);
     umbra_transfer_function tf = grey_tf(ctx, alpha_ramp);
-    umbra_renderer r = make_renderer(ctx, vol, tf, test_directional_light(0.2f, -1.0f, 0.3f),
-                                     UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, vol, tf, test_directional_light(0.2f, -1.0f, 0.3f), UMBRA_TRANSMISSION_GREY);
     float *pts = malloc(npts * 3 * sizeof *pts), *ref = malloc(npts * 3 * sizeof *ref),
           *got = malloc(npts * 3 * sizeof *got);
     assert_true(pts && ref && got);
@@ -645,8 +631,8 @@ static void test_extreme_lights_finite_and_close_to_reference(void **state)
         {"point near", test_point_light(1.1f * hx, 1.2f * hy, 0.0f), 0.015},
         {"point far", test_point_light(0.5f * hx, 6.0f * hy, 1.0f * hz), 0.008},
     };
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, cases[0].light,
-                                     UMBRA_TRANSMISSION_COLORED);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, sc.volume, sc.tf, cases[0].light, UMBRA_TRANSMISSION_COLORED);
     enum { NP = 1500 };
     float *pts = malloc(NP * 3 * sizeof *pts), *ref = malloc(NP * 3 * sizeof *ref),
           *got = malloc(NP * 3 * sizeof *got);
@@ -697,13 +683,7 @@ static void test_render_matches_reference(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 48, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = NULL;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, sc.volume), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, sc.tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_camera(r, &sc.camera), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, &sc.light), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_options(r, &sc.options), UMBRA_SUCCESS);
+    umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &sc.camera, &sc.light, &sc.options);
     enum { W = 96, H = 96 };
     float *ref = malloc(W * H * 4 * sizeof *ref), *img = malloc(W * H * 4 * sizeof *img);
     assert_true(ref && img);
@@ -748,8 +728,9 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.2f),
-                                     UMBRA_TRANSMISSION_COLORED);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, sc.volume, sc.tf, test_directional_light(0.3f, -1.0f, 0.2f),
+        UMBRA_TRANSMISSION_COLORED);
     set_shadow(r, deep_desc(64, 0.5f, 0.02f, 1, 1, 0));
     float img[32 * 32 * 4];
     umbra_render_stats s;
@@ -811,8 +792,8 @@ static void test_bad_parameters(void **state)
     umbra_context ctx = *state;
     umbra_scene sc;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &sc), UMBRA_SUCCESS);
-    umbra_renderer r = make_renderer(ctx, sc.volume, sc.tf, test_directional_light(0.0f, -1.0f, 0.0f),
-                                     UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(
+        ctx, sc.volume, sc.tf, test_directional_light(0.0f, -1.0f, 0.0f), UMBRA_TRANSMISSION_GREY);
     struct {
         umbra_shadow_desc d;
         const char *needle;

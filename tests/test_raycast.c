@@ -417,13 +417,7 @@ static void test_raycast_matches_cpu_reference(void **state)
         sh.technique = c->technique;
         sh.reference_step = 0.5f;
 
-        umbra_renderer r = NULL;
-        assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_volume(r, sc.volume), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_transfer_function(r, sc.tf), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_camera(r, &cam), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_light(r, &light), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+        umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
         assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_render(r, RC_W, RC_H, gpu), UMBRA_SUCCESS);
         umbra_render_stats stats;
@@ -461,21 +455,28 @@ static umbra_renderer scene_renderer(umbra_context ctx, umbra_scene *sc, const c
                                      uint32_t resolution, umbra_shadow_technique technique)
 {
     assert_int_equal(umbra_scene_create(ctx, name, resolution, sc), UMBRA_SUCCESS);
-    umbra_renderer r = NULL;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, sc->volume), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, sc->tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_camera(r, &sc->camera), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, &sc->light), UMBRA_SUCCESS);
     umbra_render_desc o = sc->options;
     o.jitter = 1;
-    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
+    umbra_renderer r = test_renderer(ctx, sc->volume, sc->tf, &sc->camera, &sc->light, &o);
     umbra_shadow_desc sh;
     umbra_shadow_desc_init(&sh);
     sh.technique = technique;
     sh.reference_step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
     return r;
+}
+
+/* Renders a w x h frame with options o, empty-space skipping set to skip (o keeps it), into
+ * out; returns the frame's statistics. */
+static umbra_render_stats render_skipping(umbra_renderer r, umbra_render_desc *o, int skip,
+                                          uint32_t w, uint32_t h, float *out)
+{
+    umbra_render_stats st;
+    o->empty_space_skipping = skip;
+    assert_int_equal(umbra_renderer_set_options(r, o), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_render(r, w, h, out), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    return st;
 }
 
 static void test_empty_space_skipping_changes_no_pixel(void **state)
@@ -490,15 +491,8 @@ static void test_empty_space_skipping_changes_no_pixel(void **state)
         umbra_renderer r = scene_renderer(ctx, &sc, "spheres", 48, techs[t]);
         umbra_render_desc o = sc.options;
         o.jitter = 1;
-        umbra_render_stats s_on, s_off;
-        o.empty_space_skipping = 1;
-        assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_render(r, RC_W, RC_H, on), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_get_stats(r, &s_on), UMBRA_SUCCESS);
-        o.empty_space_skipping = 0;
-        assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_render(r, RC_W, RC_H, off), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_get_stats(r, &s_off), UMBRA_SUCCESS);
+        umbra_render_stats s_on = render_skipping(r, &o, 1, RC_W, RC_H, on);
+        umbra_render_stats s_off = render_skipping(r, &o, 0, RC_W, RC_H, off);
         size_t at;
         double err = max_abs_diff(on, off, RC_W * RC_H * 4, &at);
         print_message("  %-9s: skipping on/off max |diff| %.2e, samples %llu vs %llu\n",
@@ -520,12 +514,7 @@ static uint64_t check_skipping(umbra_context ctx, umbra_volume vol, umbra_transf
                                const umbra_camera *cam, uint32_t w, uint32_t h, const char *what)
 {
     umbra_light light = test_directional_light(0.3f, -1.0f, 0.2f);
-    umbra_renderer r = NULL;
-    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_volume(r, vol), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_camera(r, cam), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_set_light(r, &light), UMBRA_SUCCESS);
+    umbra_renderer r = test_renderer(ctx, vol, tf, cam, &light, NULL);
     umbra_render_desc o;
     umbra_render_desc_init(&o);
     o.jitter = 1;
@@ -539,15 +528,8 @@ static uint64_t check_skipping(umbra_context ctx, umbra_volume vol, umbra_transf
     assert_non_null(on);
     assert_non_null(off);
     assert_non_null(cpu);
-    umbra_render_stats s_on, s_off;
-    o.empty_space_skipping = 0;
-    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_render(r, w, h, off), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_get_stats(r, &s_off), UMBRA_SUCCESS);
-    o.empty_space_skipping = 1;
-    assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_render(r, w, h, on), UMBRA_SUCCESS);
-    assert_int_equal(umbra_renderer_get_stats(r, &s_on), UMBRA_SUCCESS);
+    umbra_render_stats s_off = render_skipping(r, &o, 0, w, h, off);
+    umbra_render_stats s_on = render_skipping(r, &o, 1, w, h, on);
     float *voxels = read_voxels(ctx, vol);
     cpu_scene cs;
     fill_cpu_scene(&cs, vol, voxels, tf, cam, &light, &o, &sh);
@@ -605,19 +587,7 @@ static void test_cell_walk_edge_cases(void **state)
     assert_int_equal(umbra_transfer_function_create(ctx, table, 4, &tf), UMBRA_SUCCESS);
     static const uint32_t brick_sizes[] = {2, 3, 5, 10, 16, 64};
     for (size_t b = 0; b < sizeof brick_sizes / sizeof brick_sizes[0]; ++b) {
-        umbra_volume_desc d;
-        umbra_volume_desc_init(&d);
-        d.data = data;
-        d.type = UMBRA_FLOAT32;
-        d.dims[0] = NX;
-        d.dims[1] = NY;
-        d.dims[2] = NZ;
-        d.value_range_given = 1;
-        d.value_min = 0.0f;
-        d.value_max = 1.0f;
-        d.brick_size = brick_sizes[b];
-        umbra_volume vol = NULL;
-        assert_int_equal(umbra_volume_create(ctx, &d, &vol), UMBRA_SUCCESS);
+        umbra_volume vol = test_volume_bricks(ctx, NX, NY, NZ, data, brick_sizes[b]);
         /* Along +x, -y, +z, with pixel centres on integer world coordinates: the cell faces. */
         static const float axes[3][3] = {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}};
         for (int a = 0; a < 3; ++a) {

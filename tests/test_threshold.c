@@ -96,7 +96,8 @@ static void test_threshold_slab_crossing_matches_analytic(void **state)
     const float thresholds[] = {0.2f, 0.5f, 0.8f};
     const float target[3] = {1.3f, 0.0f, -0.7f};
     for (size_t li = 0; li < 3; ++li) {
-        umbra_renderer r = mt_renderer(ctx, vol, tf, &lights[li], UMBRA_TRANSMISSION_GREY);
+        umbra_renderer r = test_renderer_transmission(
+            ctx, vol, tf, lights[li], UMBRA_TRANSMISSION_GREY);
         for (size_t ti = 0; ti < 3; ++ti) {
             umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 256, 1);
             s.threshold = thresholds[ti];
@@ -133,7 +134,7 @@ static void test_threshold_light_transfer_function_drives_map(void **state)
     umbra_transfer_function view = mt_tf(ctx, 0.7f, 0.7f, 0.7f, a_view);
     umbra_transfer_function light = mt_tf(ctx, 0.2f, 0.2f, 0.2f, a_light);
     umbra_light l = test_directional_light(0, -1, 0);
-    umbra_renderer r = mt_renderer(ctx, vol, view, &l, UMBRA_TRANSMISSION_GREY);
+    umbra_renderer r = test_renderer_transmission(ctx, vol, view, l, UMBRA_TRANSMISSION_GREY);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 1);
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     const float top[3] = {0.4f, 0.5f * MT_NY, 0.3f}, down[3] = {0, -1, 0};

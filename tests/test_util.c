@@ -68,6 +68,12 @@ int test_group_teardown(void **state)
 umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                          const float *data)
 {
+    return test_volume_bricks(ctx, nx, ny, nz, data, 0);
+}
+
+umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                const float *data, uint32_t brick_size)
+{
     umbra_volume_desc d;
     umbra_volume_desc_init(&d);
     d.data = data;
@@ -78,6 +84,8 @@ umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t n
     d.value_range_given = 1;
     d.value_min = 0.0f;
     d.value_max = 1.0f;
+    if (brick_size)
+        d.brick_size = brick_size;
     umbra_volume v = NULL;
     assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
     return v;
@@ -94,6 +102,32 @@ umbra_volume test_constant_volume(umbra_context ctx, uint32_t nx, uint32_t ny, u
     umbra_volume v = test_volume(ctx, nx, ny, nz, data);
     free(data);
     return v;
+}
+
+umbra_renderer test_renderer(umbra_context ctx, umbra_volume volume, umbra_transfer_function tf,
+                             const umbra_camera *camera, const umbra_light *light,
+                             const umbra_render_desc *options)
+{
+    umbra_renderer r = NULL;
+    assert_int_equal(umbra_renderer_create(ctx, &r), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_volume(r, volume), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_transfer_function(r, tf), UMBRA_SUCCESS);
+    if (camera)
+        assert_int_equal(umbra_renderer_set_camera(r, camera), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_light(r, light), UMBRA_SUCCESS);
+    if (options)
+        assert_int_equal(umbra_renderer_set_options(r, options), UMBRA_SUCCESS);
+    return r;
+}
+
+umbra_renderer test_renderer_transmission(umbra_context ctx, umbra_volume volume,
+                                          umbra_transfer_function tf, umbra_light light,
+                                          umbra_transmission transmission)
+{
+    umbra_render_desc o;
+    umbra_render_desc_init(&o);
+    o.transmission = transmission;
+    return test_renderer(ctx, volume, tf, NULL, &light, &o);
 }
 
 umbra_light test_directional_light(float x, float y, float z)

@@ -42,6 +42,21 @@ umbra_light test_directional_light(float x, float y, float z);
 /* A white point light at (x, y, z). */
 umbra_light test_point_light(float x, float y, float z);
 
+/* A renderer on volume and tf lit by light, with the camera and options given (umbra's defaults
+ * where NULL); every step asserted. */
+umbra_renderer test_renderer(umbra_context ctx, umbra_volume volume, umbra_transfer_function tf,
+                             const umbra_camera *camera, const umbra_light *light,
+                             const umbra_render_desc *options);
+
+/* test_renderer without a camera, with default options but the given transmission. */
+umbra_renderer test_renderer_transmission(umbra_context ctx, umbra_volume volume,
+                                          umbra_transfer_function tf, umbra_light light,
+                                          umbra_transmission transmission);
+
+/* A float32 volume as test_volume with the given brick edge (0: umbra's default). */
+umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                const float *data, uint32_t brick_size);
+
 /* A grey transfer function with constant alpha (per voxel) everywhere. */
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha);
 
