@@ -203,7 +203,7 @@ void umbra_renderer_release(umbra_renderer r)
     release_kernels(r);
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
-                      &r->light_tf_buf, &r->view_bricks_buf, &r->light_bricks_buf, &r->view_cells_buf,
+                      &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
                       &r->out_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         release_mem(mems[i]);
@@ -501,20 +501,20 @@ static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_
     return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
 }
 
-/* The step-corrected table of tf and its brick table (and, with cell_buf, its cell masks), kept
- * while tf, the volume and the step stay the same. */
+/* The step-corrected table of tf, its cell masks and, with brick_buf, its brick table, kept while
+ * tf, the volume and the step stay the same. */
 static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                            uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf, cl_mem *cell_buf)
 {
     uint32_t bits;
     memcpy(&bits, &step_voxels, sizeof bits);
     uint64_t want[3] = {tf->id, r->volume->id, bits};
-    if (*tf_buf && *brick_buf && (!cell_buf || *cell_buf) && memcmp(want, key, sizeof want) == 0)
+    if (*tf_buf && *cell_buf && (!brick_buf || *brick_buf) && memcmp(want, key, sizeof want) == 0)
         return UMBRA_SUCCESS;
     umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
-    if (st == UMBRA_SUCCESS)
+    if (st == UMBRA_SUCCESS && brick_buf)
         st = brick_table(r, tf, brick_buf);
-    if (st == UMBRA_SUCCESS && cell_buf)
+    if (st == UMBRA_SUCCESS)
         st = cell_table(r, tf, cell_buf);
     if (st == UMBRA_SUCCESS)
         memcpy(key, want, sizeof want);
@@ -525,8 +525,8 @@ static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float s
 
 umbra_status umbra__light_tables(umbra_renderer r, float step_voxels)
 {
-    return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf,
-                  &r->light_bricks_buf, NULL);
+    return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf, NULL,
+                  &r->light_cells_buf);
 }
 
 /* ---- per-frame constants ------------------------------------------------------------------------------ */
@@ -668,9 +668,11 @@ umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)
     umbra_status st = UMBRA_SUCCESS;
     cl_mem vol = r->volume->image ? r->volume->image : r->volume->data;
     cl_mem view_tf = r->view_tf_buf ? r->view_tf_buf : r->light_tf_buf;
-    cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_bricks_buf;
+    /* A shadow build runs before the view tables exist and does not read them: any buffer will
+     * do for the argument. */
+    cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_cells_buf;
     cl_mem args[] = {r->frame_buf, vol, view_tf, r->light_tf_buf, view_bricks,
-                     r->light_bricks_buf, r->shadow_buf};
+                     r->light_cells_buf, r->shadow_buf};
     for (cl_uint i = 0; i < sizeof args / sizeof args[0]; ++i)
         UMBRA_CL(clSetKernelArg(k, i, sizeof(cl_mem), &args[i]));
     *next = (cl_uint)(sizeof args / sizeof args[0]);

@@ -70,8 +70,9 @@ struct umbra_renderer_t {
     /* device resources, re-created only when their inputs change */
     cl_mem frame_buf, shadow_buf, samples_buf;
     cl_mem view_tf_buf, light_tf_buf;        /* tables with step-corrected alpha */
-    cl_mem view_bricks_buf, light_bricks_buf;/* uchar per brick: nonzero if visible */
-    cl_mem view_cells_buf;                   /* ulong per brick: its visible sub-cells (view) */
+    cl_mem view_bricks_buf;                  /* uchar per brick: nonzero if visible (view) */
+    cl_mem view_cells_buf, light_cells_buf;  /* ulong per brick: its visible sub-cells; a brick
+                                              * is visible if any of them is */
     uint64_t view_tf_key[3], light_tf_key[3];/* (tf id, volume id, step bits) they were made for */
     umbra__light_key built;                  /* inputs of the current shadow structure */
     int built_valid;
@@ -95,7 +96,7 @@ float umbra__voxel_world(umbra_renderer r);
 void umbra__frame_update_light(umbra_renderer r);
 
 /* Makes sure r->light_tf_buf holds the light table corrected for step_voxels and
- * r->light_bricks_buf the visibility of each brick under it. */
+ * r->light_cells_buf the visibility of each brick's sub-cells under it. */
 umbra_status umbra__light_tables(umbra_renderer r, float step_voxels);
 
 /* Uploads r->frame and r->shadow_params to the device. */

@@ -97,7 +97,14 @@ inline int brick_index(VolGeom g, float3 p)
     return (b.z * g.bricks.y + b.y) * g.bricks.x + b.x;
 }
 
-/* ---- the view ray's walk over the bricks' sub-cells --------------------------------------------
+/* The first sample index k (samples at t0 + (k + offset) h) that lies past t_exit, at least k+1. */
+inline int next_sample_after(float t0, float h, float offset, float t_exit, int k)
+{
+    float kk = ceil((t_exit - t0) / h - offset);
+    return (kk > (float)(k + 1)) ? (int)fmin(kk, 2147483000.0f) : k + 1;
+}
+
+/* ---- a ray's walk over the bricks' sub-cells ----------------------------------------------------
  * A 3D DDA (Amanatides & Woo 1987) in voxel coordinates over the cells of kernels/umbra_shared.h:
  * along each axis, brick b's cell j covers the positions [b B + j C, b B + min((j + 1) C, B)),
  * C = ceil(B / UMBRA_BRICK_CELLS), and the border cells reach on to infinity, as the clamped
@@ -272,6 +279,32 @@ UMBRA_INLINE float walk_to_visible(CellWalk *w, VolGeom g, __global const ulong 
     }
 }
 
+/* Empty-space skipping on a ray sampled at t0 + (k + offset) h, k < n: the first sample index at
+ * or after k that lies in a visible cell of the cell masks (walking w on to that cell and setting
+ * *t_cell to its exit, before which later samples need no test), or n if there is none before
+ * t_end. The cell of a sample is the walk's: a sample on a face may be counted to either side
+ * (the rounding of t), which changes no value, as both cells' footprints hold the face's voxels. */
+UMBRA_INLINE int walk_next_sample(CellWalk *w, VolGeom g, __global const ulong *cells, float t0,
+                                  float h, float offset, int k, int n, float t_end, float *t_cell)
+{
+    for (;;) {
+        float t = t0 + ((float)k + offset) * h;
+        const float t_in = walk_to_visible(w, g, cells, t, t_end);
+        if (t_in > t) {
+            if (!(t_in < t_end))
+                return n;
+            k = next_sample_after(t0, h, offset, t_in, k);
+            if (k >= n)
+                return n;
+            t = t0 + ((float)k + offset) * h;
+            if (!(t < walk_exit(w)))
+                continue; /* the visible cell holds no sample: walk on from t */
+        }
+        *t_cell = walk_exit(w);
+        return k;
+    }
+}
+
 /* The ray parameter at which o + t d leaves the brick containing o + t_now d. */
 inline float brick_exit(VolGeom g, float3 o, float3 d, float t_now)
 {
@@ -290,12 +323,6 @@ inline float brick_exit(VolGeom g, float3 o, float3 d, float t_now)
     return fmin(fmin(t.x, t.y), t.z);
 }
 
-/* The first sample index k (samples at t0 + (k + offset) h) that lies past t_exit, at least k+1. */
-inline int next_sample_after(float t0, float h, float offset, float t_exit, int k)
-{
-    float kk = ceil((t_exit - t0) / h - offset);
-    return (kk > (float)(k + 1)) ? (int)fmin(kk, 2147483000.0f) : k + 1;
-}
 
 /* Direction towards the light and the distance to it (infinite for a directional light). */
 inline float4 to_light(__global const UmbraFrame *F, float3 p)

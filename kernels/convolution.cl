@@ -215,7 +215,7 @@ inline void conv_shade(__global const UmbraFrame *F, float3 c, float3 p, float3 
 __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
                                 __global const float4 *view_tf, __global const float4 *light_tf,
                                 __global const uchar *view_bricks,
-                                __global const uchar *light_bricks,
+                                __global const ulong *light_cells,
                                 __global const UmbraShadow *S, __global const float4 *pi_view,
                                 __global const float4 *pi_light, __global const float *a_prev,
                                 __global float *a_next, __global const float *l_prev,
@@ -277,7 +277,7 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
             const float3 p = P.o + P.d * (z / P.cosv);
             if (skip) {
                 int b = brick_index(g, p);
-                if (!view_bricks[b] && !light_bricks[b])
+                if (!view_bricks[b] && !light_cells[b])
                     continue;
             }
             float4 c;

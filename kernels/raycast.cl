@@ -51,7 +51,7 @@ inline void camera_ray(__global const UmbraFrame *F, int px, int py, float3 *o, 
 
 __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const float4 *view_tf, __global const float4 *light_tf,
-                             __global const uchar *view_bricks, __global const uchar *light_bricks,
+                             __global const uchar *view_bricks, __global const ulong *light_cells,
                              __global const UmbraShadow *S, __global float4 *out,
                              __global UMBRA_COUNT_T *samples, __global const float4 *preint,
                              uint preint_size, __global const ulong *view_cells SHADOW_KERNEL_PARAMS)
@@ -110,18 +110,10 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         for (int k = 0; k < n;) {
             float t = t0 + ((float)k + jitter) * h;
             if (walk_cells && t >= t_cell) {
-                const float t_in = walk_to_visible(&w, g, view_cells, t, t1);
-                if (t_in > t) {
-                    if (!(t_in < t1))
-                        break;
-                    k = next_sample_after(t0, h, jitter, t_in, k);
-                    if (k >= n)
-                        break;
-                    t = t0 + ((float)k + jitter) * h;
-                    if (!(t < walk_exit(&w)))
-                        continue; /* the visible cell holds no sample: walk on from t */
-                }
-                t_cell = walk_exit(&w);
+                k = walk_next_sample(&w, g, view_cells, t0, h, jitter, k, n, t1, &t_cell);
+                if (k >= n)
+                    break;
+                t = t0 + ((float)k + jitter) * h;
             }
             float3 p = o + t * d;
             if (skip && preint_size && t >= t_visible) {
@@ -178,7 +170,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
 __kernel void raycast_query_shadow(__global const UmbraFrame *F, VOLUME_PARAM,
                                    __global const float4 *view_tf, __global const float4 *light_tf,
                                    __global const uchar *view_bricks,
-                                   __global const uchar *light_bricks,
+                                   __global const ulong *light_cells,
                                    __global const UmbraShadow *S, __global const float *points,
                                    __global float *rgb, uint count SHADOW_KERNEL_PARAMS)
 {

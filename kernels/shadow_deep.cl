@@ -382,7 +382,7 @@ inline int deep_quant(float s)
  * to e and returns their number (at most DEEP_MAX_EMIT: one per distinct position, one for the
  * gap point, one for the fit's first node, three when the ray ends). Sets T->done at the end. */
 inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
-                     __global const float4 *light_tf, __global const uchar *light_bricks,
+                     __global const float4 *light_tf, __global const ulong *light_cells,
                      __global const UmbraShadow *S, __global const deep_node *lut, uint use_lut,
                      deep_node *e)
 {
@@ -411,7 +411,7 @@ inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, V
             continue;
         }
         const float3 pa = s->o + a * s->d, pb = s->o + b * s->d;
-        if (skip && !light_bricks[brick_index(g, pa)] && !light_bricks[brick_index(g, pb)]) {
+        if (skip && !light_cells[brick_index(g, pa)] && !light_cells[brick_index(g, pb)]) {
             /* Both ends in bricks the light transfer function leaves empty: transparent. */
             s->has_prev = 0;
             v_end += s->w * s->v;
@@ -532,7 +532,7 @@ inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, V
  * take part with nothing to march). */
 __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
-                         __global const uchar *view_bricks, __global const uchar *light_bricks,
+                         __global const uchar *view_bricks, __global const ulong *light_cells,
                          __global const UmbraShadow *S, __global const deep_node *lut,
                          uint use_lut, uint prefilter, float eps, __global deep_node *nodes,
                          __global int *head, __global int *next, __global uint *counts,
@@ -565,7 +565,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
         /* March until a node is ready or the ray is done: a ray that still runs may emit
          * nothing more (transparent to its end), and must not make the tile take a block. */
         while (ppos == npend && !st.done) {
-            npend = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, pend);
+            npend = deep_step(&st, F, vol, g, light_tf, light_cells, S, lut, use_lut, pend);
             ppos = 0;
         }
         if (lane == 0)
@@ -595,7 +595,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
             if (ppos == npend) {
                 if (st.done)
                     break;
-                npend = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, pend);
+                npend = deep_step(&st, F, vol, g, light_tf, light_cells, S, lut, use_lut, pend);
                 ppos = 0;
                 continue;
             }
@@ -641,7 +641,7 @@ inline void deep_fixed_add(__global deep_node *o, int N, int *cnt, deep_node e)
 __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
                                __global const float4 *view_tf, __global const float4 *light_tf,
                                __global const uchar *view_bricks,
-                               __global const uchar *light_bricks, __global const UmbraShadow *S,
+                               __global const ulong *light_cells, __global const UmbraShadow *S,
                                __global const deep_node *lut, uint use_lut, uint prefilter,
                                float eps, __global deep_node *out)
 {
@@ -659,7 +659,7 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
     deep_node e[DEEP_MAX_EMIT];
     int cnt = 0;
     while (!st.done) {
-        int ne = deep_step(&st, F, vol, g, light_tf, light_bricks, S, lut, use_lut, e);
+        int ne = deep_step(&st, F, vol, g, light_tf, light_cells, S, lut, use_lut, e);
         for (int q = 0; q < ne; ++q)
             deep_fixed_add(o, N, &cnt, e[q]);
     }

@@ -6,7 +6,7 @@
  *   ShadowRay               per-view-ray state (e.g. where the last lookup ended)
  *   shadow_ray_init(&sr)    resets it at the start of a view ray
  *   SHADOW_FACTOR(sr, p)    RGB shadow factor at world point p; may use the raycast kernel's
- *                           parameters F, vol, g, light_tf, light_bricks, S by name */
+ *                           parameters F, vol, g, light_tf, light_cells, S by name */
 
 #define SHADOW_KERNEL_PARAMS
 

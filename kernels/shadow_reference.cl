@@ -6,7 +6,7 @@
  * whole steps h plus one final partial step, each sampled at its midpoint, so the segment lengths
  * add up to the path length exactly; the light table is corrected for h on the host and the final
  * step re-corrected for its fraction. A homogeneous slab therefore gives exp(-sigma d) for every h,
- * to float precision. Empty bricks (for the light transfer function) are skipped on the same
+ * to float precision. Cells the light transfer function leaves empty are skipped on the same
  * sample grid, so skipping changes no value; the march stops once every channel is below 1e-6. */
 
 #define SHADOW_KERNEL_PARAMS
@@ -19,7 +19,7 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
 inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
                                __global const float4 *light_tf,
-                               __global const uchar *light_bricks,
+                               __global const ulong *light_cells,
                                __global const UmbraShadow *S, float3 p)
 {
     float4 l = to_light(F, p);
@@ -37,20 +37,19 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     int n_full = (int)floor(len / h);
     float last = len - (float)n_full * h;
     light_t T = (light_t)(1.0f);
-    /* Samples before t_visible lie in a brick already found visible: the brick table is read
-     * once per brick crossed, not once per sample. */
-    float t_visible = -UMBRA_INF;
+    /* The ray walks the cells of the light's cell masks (CellWalk) and samples only visible ones;
+     * samples before t_cell lie in a cell already found visible. */
+    CellWalk w = walk_begin(g, p, d, t_start);
+    float t_cell = -UMBRA_INF;
     for (int k = 0; k < n_full;) {
         float t = t_start + ((float)k + 0.5f) * h;
-        float3 q = p + t * d;
-        if (skip && t >= t_visible) {
-            float t_exit = brick_exit(g, p, d, t);
-            if (!light_bricks[brick_index(g, q)]) {
-                k = next_sample_after(t_start, h, 0.5f, t_exit, k);
-                continue;
-            }
-            t_visible = t_exit;
+        if (skip && t >= t_cell) {
+            k = walk_next_sample(&w, g, light_cells, t_start, h, 0.5f, k, n_full, t_end, &t_cell);
+            if (k >= n_full)
+                break;
+            t = t_start + ((float)k + 0.5f) * h;
         }
+        float3 q = p + t * d;
         float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
         T *= light_pass(c, flags);
         if (light_max(T) < 1e-6f)
@@ -65,4 +64,4 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     return light_rgb(T);
 }
 
-#define SHADOW_FACTOR(sr, p) reference_shadow(F, vol, g, light_tf, light_bricks, S, (p))
+#define SHADOW_FACTOR(sr, p) reference_shadow(F, vol, g, light_tf, light_cells, S, (p))

@@ -25,7 +25,7 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
                               __global const float4 *view_tf, __global const float4 *light_tf,
                               __global const uchar *view_bricks,
-                              __global const uchar *light_bricks, __global const UmbraShadow *S,
+                              __global const ulong *light_cells, __global const UmbraShadow *S,
                               __global float *map)
 {
     const int x = get_global_id(0), y = get_global_id(1);
@@ -46,24 +46,19 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
         const int n_full = (int)floor(len / h);
         const float last = len - (float)n_full * h;
         float A = 0.0f;
-        float t_visible = -UMBRA_INF;
-        /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. */
+        CellWalk w = walk_begin(g, o, d, tb.x);
+        float t_cell = -UMBRA_INF;
+        /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. Whole
+         * segments whose midpoint lies in an invisible cell are skipped (walk_next_sample). */
         for (int k = 0; k <= n_full;) {
+            if (skip && k < n_full && tb.x + ((float)k + 0.5f) * h >= t_cell)
+                k = walk_next_sample(&w, g, light_cells, tb.x, h, 0.5f, k, n_full, tb.y, &t_cell);
             const float seg = k < n_full ? h : last;
             if (!(seg > 0.0f))
                 break;
             const float t_start = tb.x + (float)k * h;
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
-            /* The brick table is read once per brick crossed (t_visible), not per sample. */
-            if (skip && k < n_full && t_mid >= t_visible) {
-                const float t_exit = brick_exit(g, o, d, t_mid);
-                if (!light_bricks[brick_index(g, q)]) {
-                    k = next_sample_after(tb.x, h, 0.5f, t_exit, k);
-                    continue;
-                }
-                t_visible = t_exit;
-            }
             float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
             if (k == n_full)
                 c = alpha_for_fraction(c, seg / h);

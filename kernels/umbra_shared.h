@@ -17,9 +17,10 @@ typedef int int32_t;
 
 /* Empty-space skipping: each brick of the volume is split into UMBRA_BRICK_CELLS^3 sub-cells of
  * ceil(brick_size / UMBRA_BRICK_CELLS) voxels, one bit each (x fastest) of a 64-bit mask per
- * brick. View rays walk the grid of sub-cells, crossing a brick with no visible cell in one step,
- * and take samples only in visible cells (CellWalk, kernels/common.cl); host/volume.c keeps the
- * cells' ranges. */
+ * brick, for the view and for the light transfer function. View rays, the reference's shadow
+ * rays and the threshold and CSSM maps' light rays walk the grid of sub-cells, crossing a brick
+ * with no visible cell in one step, and take samples only in visible cells (CellWalk,
+ * kernels/common.cl); host/volume.c keeps the cells' ranges. */
 #define UMBRA_BRICK_CELLS 4
 
 /* Flags in UmbraFrame.flags. */

@@ -8,6 +8,8 @@
  *    where nothing lies between point and light;
  *  - a camera move re-uses the map, a light change rebuilds it, and the reported memory is the
  *    map's size;
+ *  - empty-space skipping of the light rays (the walk over the light's cell masks) changes no
+ *    pixel, for the scene's directional light and a point light;
  *  - the image on the spheres scene stays within a stated mean error of the exact reference. */
 #ifndef UMBRA_TESTS_SHADOW_MAP_TEST_H
 #define UMBRA_TESTS_SHADOW_MAP_TEST_H
@@ -213,6 +215,39 @@ static inline void mt_check_stress_lights(umbra_context ctx, umbra_shadow_desc s
     umbra_volume_release(vol);
 }
 
+/* ---- empty-space skipping -------------------------------------------------------------------- */
+
+/* The spheres at 64x64 with skipping off and on, for the scene's light and a point light above
+ * a corner: the light rays sample the same grid either way, and what skipping leaves out has
+ * opacity 0, so the pictures agree (to 1e-6, for a sample on a cell face that rounding may count
+ * to either cell). */
+static inline void mt_check_skipping_changes_nothing(umbra_context ctx, umbra_shadow_desc shadow)
+{
+    umbra_scene scene;
+    assert_int_equal(umbra_scene_create(ctx, "spheres", 48, &scene), UMBRA_SUCCESS);
+    const umbra_light lights[2] = {scene.light, test_point_light(30.0f, 45.0f, -25.0f)};
+    enum { W = 64, H = 64 };
+    static float img[2][W * H * 4];
+    for (int l = 0; l < 2; ++l) {
+        for (int skip = 0; skip < 2; ++skip) {
+            umbra_render_desc o = scene.options;
+            o.empty_space_skipping = skip;
+            umbra_renderer r =
+                test_renderer(ctx, scene.volume, scene.tf, &scene.camera, &lights[l], &o);
+            assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
+            assert_int_equal(umbra_renderer_render(r, W, H, img[skip]), UMBRA_SUCCESS);
+            umbra_renderer_release(r);
+        }
+        double worst = 0.0;
+        for (size_t i = 0; i < W * H * 4; ++i)
+            worst = fmax(worst, fabs((double)img[0][i] - img[1][i]));
+        printf("%s, light %d: skipping on/off max |diff| %.2e\n",
+               umbra_shadow_technique_name(shadow.technique), l, worst);
+        assert_true(worst <= 1e-6);
+    }
+    umbra_scene_release(&scene);
+}
+
 /* ---- caching and memory --------------------------------------------------------------------- */
 
 /* Camera moves re-use the map; a light change and a light transfer function change rebuild it;
@@ -224,7 +259,7 @@ static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_des
     umbra_scene scene;
     assert_int_equal(umbra_scene_create(ctx, "spheres", 32, &scene), UMBRA_SUCCESS);
     umbra_renderer r = test_renderer_transmission(ctx, scene.volume, scene.tf, scene.light,
-                                   UMBRA_TRANSMISSION_COLORED);
+                                                  UMBRA_TRANSMISSION_COLORED);
     enum { W = 32, H = 32 };
     float img[W * H * 4];
     umbra_render_stats st;

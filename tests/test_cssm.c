@@ -219,6 +219,12 @@ static void test_cssm_stress_lights_finite_and_lit(void **state)
     mt_check_stress_lights(ctx, mt_shadow(UMBRA_SHADOW_CSSM, 128, 21));
 }
 
+static void test_cssm_skipping_changes_nothing(void **state)
+{
+    (void)state;
+    mt_check_skipping_changes_nothing(ctx, mt_shadow(UMBRA_SHADOW_CSSM, 128, 13));
+}
+
 static void test_cssm_camera_move_reuses_map(void **state)
 {
     (void)state;
@@ -281,6 +287,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_cssm_same_seed_same_image_bitwise),
         cmocka_unit_test(test_cssm_stress_lights_finite_and_lit),
         cmocka_unit_test(test_cssm_camera_move_reuses_map),
+        cmocka_unit_test(test_cssm_skipping_changes_nothing),
         cmocka_unit_test(test_cssm_error_vs_reference_bounded),
         cmocka_unit_test(test_cssm_invalid_parameters_rejected),
     };

@@ -163,6 +163,12 @@ static void test_threshold_stress_lights_finite_and_lit(void **state)
     mt_check_stress_lights(ctx, mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 1));
 }
 
+static void test_threshold_skipping_changes_nothing(void **state)
+{
+    (void)state;
+    mt_check_skipping_changes_nothing(ctx, mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 13));
+}
+
 static void test_threshold_camera_move_reuses_map(void **state)
 {
     (void)state;
@@ -227,6 +233,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_threshold_light_transfer_function_drives_map),
         cmocka_unit_test(test_threshold_stress_lights_finite_and_lit),
         cmocka_unit_test(test_threshold_camera_move_reuses_map),
+        cmocka_unit_test(test_threshold_skipping_changes_nothing),
         cmocka_unit_test(test_threshold_error_vs_reference_bounded),
         cmocka_unit_test(test_threshold_invalid_parameters_rejected),
     };

@@ -402,6 +402,10 @@ static void pass(const prep *P, const float c[4], float out[3])
         out[ch] = 1.0f - c[3] * (1.0f - (P->colored ? c[ch] : 0.0f));
 }
 
+/* The exact reference's shadow ray. It skips whole bricks the light transfer function leaves
+ * empty, where the kernel walks their sub-cells (kernels/shadow_reference.cl): both skip only
+ * samples of opacity 0 on the same sample grid, so the values agree and the simpler test stays
+ * an independent check of the kernel's walk. */
 static v3 shadow(const prep *P, v3 p)
 {
     float dist;
