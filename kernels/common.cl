@@ -323,7 +323,6 @@ inline float brick_exit(VolGeom g, float3 o, float3 d, float t_now)
     return fmin(fmin(t.x, t.y), t.z);
 }
 
-
 /* Direction towards the light and the distance to it (infinite for a directional light). */
 inline float4 to_light(__global const UmbraFrame *F, float3 p)
 {
