@@ -17,6 +17,7 @@ typedef struct VolGeom {
     int3 dims;
     int3 bricks;
     int brick_size;
+    int cell_size; /* voxels along a brick's sub-cell: ceil(brick_size / UMBRA_BRICK_CELLS) */
 } VolGeom;
 
 inline VolGeom vol_geom(__global const UmbraFrame *F)
@@ -29,6 +30,7 @@ inline VolGeom vol_geom(__global const UmbraFrame *F)
     g.dims = (int3)(F->dims[0], F->dims[1], F->dims[2]);
     g.bricks = (int3)(F->bricks[0], F->bricks[1], F->bricks[2]);
     g.brick_size = F->bricks[3];
+    g.cell_size = (g.brick_size + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
     return g;
 }
 
@@ -138,7 +140,7 @@ UMBRA_INLINE float walk_face(float x, float inv, int dir, int b, int c, int B, i
 /* The current cell's three exit parameters. */
 UMBRA_INLINE void walk_set_faces(CellWalk *w, VolGeom g)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    const int B = g.brick_size, C = g.cell_size;
     w->t_face = (float3)(walk_face(w->xo.x, w->inv_xd.x, w->dir.x, w->brick.x, w->cell.x, B, C, g.bricks.x),
                          walk_face(w->xo.y, w->inv_xd.y, w->dir.y, w->brick.y, w->cell.y, B, C, g.bricks.y),
                          walk_face(w->xo.z, w->inv_xd.z, w->dir.z, w->brick.z, w->cell.z, B, C, g.bricks.z));
@@ -147,7 +149,7 @@ UMBRA_INLINE void walk_set_faces(CellWalk *w, VolGeom g)
 /* The cell of brick b holding voxel position x, clamped into the brick. */
 UMBRA_INLINE int3 walk_cell_at(VolGeom g, int3 b, float3 x)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    const int B = g.brick_size, C = g.cell_size;
     return clamp(convert_int3(floor((x - convert_float3(b * B)) / (float)C)), (int3)(0),
                  (int3)((B - 1) / C));
 }
@@ -155,16 +157,14 @@ UMBRA_INLINE int3 walk_cell_at(VolGeom g, int3 b, float3 x)
 /* The walk of the ray o + t d from its point at t. */
 UMBRA_INLINE CellWalk walk_begin(VolGeom g, float3 o, float3 d, float t)
 {
-    const int B = g.brick_size;
     CellWalk w;
     const float3 xd = d * g.inv_spacing;
     w.xo = world_to_voxel(g, o);
     w.xd = xd;
     w.inv_xd = 1.0f / xd;
     w.dir = select(select((int3)(0), (int3)(-1), xd < 0.0f), (int3)(1), xd > 0.0f);
-    float3 x = w.xo + t * xd;
-    w.brick = clamp(convert_int3(floor(x / (float)B)), (int3)(0), g.bricks - 1);
-    w.cell = walk_cell_at(g, w.brick, x);
+    w.brick = brick_coords(g, o + t * d);
+    w.cell = walk_cell_at(g, w.brick, w.xo + t * xd);
     walk_set_faces(&w, g);
     w.t_in = t;
     return w;
@@ -188,7 +188,7 @@ UMBRA_INLINE int2 walk_step_axis(int dir, int b, int c, int B, int C)
  * leaves the current one: walk_exit < infinity). */
 UMBRA_INLINE void walk_advance(CellWalk *w, VolGeom g)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    const int B = g.brick_size, C = g.cell_size;
     const float3 tf = w->t_face;
     w->t_in = walk_exit(w);
     if (tf.x <= tf.y && tf.x <= tf.z) {
@@ -227,7 +227,7 @@ UMBRA_INLINE float walk_brick_face(float x, float inv, int dir, int b, int B, in
  * walk (t_in = UMBRA_INF). */
 UMBRA_INLINE void walk_skip_brick(CellWalk *w, VolGeom g)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    const int B = g.brick_size, C = g.cell_size;
     const int last = (B - 1) / C;
     const float3 tb = (float3)(walk_brick_face(w->xo.x, w->inv_xd.x, w->dir.x, w->brick.x, B, g.bricks.x),
                                walk_brick_face(w->xo.y, w->inv_xd.y, w->dir.y, w->brick.y, B, g.bricks.y),

@@ -33,7 +33,7 @@ typedef struct prep {
     int view_n, light_n;
     unsigned char *light_bricks;  /* per brick, visible to the light transfer function */
     uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
-    int nb[3], B;
+    int nb[3], B, C;              /* bricks per axis, brick edge, sub-cell edge (voxels) */
     float step, shadow_step;
     int colored, point;
     v3 light_vec;                 /* point position or unit travel direction */
@@ -132,7 +132,7 @@ enum { CELLS = 4 };
 static uint64_t *cells(const prep *P, const float *tf, int n)
 {
     const cpu_scene *s = P->s;
-    const int B = P->B, C = (P->B + CELLS - 1) / CELLS;
+    const int B = P->B, C = P->C;
     uint64_t *out = calloc((size_t)P->nb[0] * P->nb[1] * P->nb[2], sizeof *out);
     if (!out)
         return NULL;
@@ -173,7 +173,7 @@ typedef struct walk {
 
 static float walk_face(const prep *P, const walk *w, int a)
 {
-    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    const int B = P->B, C = P->C;
     if (w->dir[a] > 0) {
         int hi = (w->c[a] + 1) * C < B ? (w->c[a] + 1) * C : B;
         return (w->b[a] == P->nb[a] - 1 && hi == B) ? INFINITY
@@ -188,14 +188,15 @@ static float walk_face(const prep *P, const walk *w, int a)
 /* The cell of the current brick holding voxel position x along axis a, clamped into the brick. */
 static int walk_cell_at(const prep *P, const walk *w, int a, float x)
 {
-    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    const int B = P->B, C = P->C;
     int c = (int)floorf((x - (float)(w->b[a] * B)) / (float)C);
     return c < 0 ? 0 : (c > (B - 1) / C ? (B - 1) / C : c);
 }
 
+static int brick_of(const prep *P, v3 p, int b[3]);
+
 static void walk_begin(const prep *P, walk *w, v3 o, v3 d, float t)
 {
-    const int B = P->B;
     float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
     float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z};
     float is[3] = {P->inv_spacing.x, P->inv_spacing.y, P->inv_spacing.z};
@@ -205,11 +206,10 @@ static void walk_begin(const prep *P, walk *w, v3 o, v3 d, float t)
         w->xd[a] = xd;
         w->inv[a] = 1.0f / xd;
         w->dir[a] = xd > 0.0f ? 1 : (xd < 0.0f ? -1 : 0);
-        float x = w->xo[a] + t * xd;
-        int b = (int)floorf(x / (float)B);
-        w->b[a] = b < 0 ? 0 : (b > P->nb[a] - 1 ? P->nb[a] - 1 : b);
-        w->c[a] = walk_cell_at(P, w, a, x);
     }
+    brick_of(P, add(o, mul(d, t)), w->b);
+    for (int a = 0; a < 3; ++a)
+        w->c[a] = walk_cell_at(P, w, a, w->xo[a] + t * w->xd[a]);
     for (int a = 0; a < 3; ++a)
         w->face[a] = walk_face(P, w, a);
     w->t_in = t;
@@ -222,7 +222,7 @@ static float walk_exit(const walk *w)
 
 static void walk_advance(const prep *P, walk *w)
 {
-    const int B = P->B, C = (B + CELLS - 1) / CELLS;
+    const int B = P->B, C = P->C;
     int a = w->face[0] <= w->face[1] && w->face[0] <= w->face[2] ? 0 : (w->face[1] <= w->face[2] ? 1 : 2);
     w->t_in = walk_exit(w);
     if (w->dir[a] > 0) {
@@ -246,7 +246,7 @@ static void walk_advance(const prep *P, walk *w)
  * the ray leaves the grid. */
 static void walk_skip_brick(const prep *P, walk *w)
 {
-    const int B = P->B, C = (B + CELLS - 1) / CELLS, last = (B - 1) / C;
+    const int B = P->B, C = P->C, last = (B - 1) / C;
     float tb[3];
     for (int a = 0; a < 3; ++a) {
         tb[a] = INFINITY;
@@ -307,6 +307,7 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->step = s->opts.step * P->voxel;
     P->shadow_step = s->reference_step * P->voxel;
     P->B = s->brick_size;
+    P->C = (P->B + CELLS - 1) / CELLS;
     for (int a = 0; a < 3; ++a)
         P->nb[a] = (s->dims[a] + P->B - 1) / P->B;
     const float *ltf = s->light_tf ? s->light_tf : s->tf;
