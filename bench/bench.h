@@ -13,7 +13,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 /* ---- subcommands ------------------------------------------------------------------------------ */
 

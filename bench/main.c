@@ -20,7 +20,8 @@ static const bench_command commands[] = {
 static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench <subcommand> [options]\n"
-               "       umbra-bench <subcommand> --help\n\nsubcommands:\n");
+               "       umbra-bench <subcommand> --help\n"
+               "       umbra-bench --version\n\nsubcommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
         fprintf(f, "  %-12s %s\n", commands[i].name, commands[i].help);
     fprintf(f, "\nEnvironment: UMBRA_DEVICE picks the OpenCL device, UMBRA_DATA_DIR where the "
@@ -36,6 +37,10 @@ int main(int argc, char **argv)
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "help") == 0) {
         usage(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("umbra-bench %s (library %s)\n", UMBRA_VERSION_STRING, umbra_version());
         return 0;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)

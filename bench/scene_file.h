@@ -43,7 +43,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 #define SCENE_PATH_MAX 4096
 #define SCENE_PAPERS_CSSM 1

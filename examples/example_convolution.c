@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 /* Translucent flesh, opaque bone (bench/scenes/carp.tf). */
 static const umbra_tf_point carp_tf[] = {

@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 int main(int argc, char **argv)
 {

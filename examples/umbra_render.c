@@ -7,12 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
         "usage: umbra-render [options]\n"
+        "  --version             print the version and exit\n"
         "  --scene NAME          built-in scene: spheres (default), slab, marschner-lobb\n"
         "  --scene-size N        built-in scene resolution N^3 (default per scene)\n"
         "  --volume FILE         volume file: .nrrd/.nhdr (Teem) or .dat (Voreen)\n"
@@ -133,6 +134,9 @@ static int parse_args(int argc, char **argv, options *o)
     } while (0)
         if (FLAG("--help") || FLAG("-h")) {
             usage(stdout);
+            exit(0);
+        } else if (FLAG("--version")) {
+            printf("umbra-render %s (library %s)\n", UMBRA_VERSION_STRING, umbra_version());
             exit(0);
         } else if (FLAG("--scene")) { NEED(); o->scene = v; }
         else if (FLAG("--scene-size")) { NEED(); if (!parse_uint(v, &o->scene_size)) BAD("--scene-size '%s' is not a whole number", v); }

@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 #define WALNUT_IMAGE_WIDTH 800u
 #define WALNUT_IMAGE_HEIGHT 600u

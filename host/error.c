@@ -7,6 +7,16 @@
 
 #include "internal.h"
 
+const char *umbra_version(void)
+{
+    return UMBRA_VERSION_STRING;
+}
+
+unsigned umbra_version_number(void)
+{
+    return UMBRA_VERSION;
+}
+
 const char *umbra_status_to_string(umbra_status status)
 {
     switch (status) {
@@ -44,6 +54,13 @@ umbra_status umbra__fail(umbra_context ctx, umbra_status status, const char *fmt
     vsnprintf(message, sizeof message, fmt, ap);
     va_end(ap);
     record(ctx, status, message);
+    return status;
+}
+
+umbra_status umbra_context_record_error(umbra_context ctx, umbra_status status,
+                                        const char *message)
+{
+    record(ctx, status, message ? message : "");
     return status;
 }
 

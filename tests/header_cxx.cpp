@@ -1,5 +1,5 @@
 // Compiles the public API as C++: every declaration must be valid there too.
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 int umbra_header_compiles_as_cxx();
 int umbra_header_compiles_as_cxx() { return static_cast<int>(UMBRA_SUCCESS); }

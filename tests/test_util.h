@@ -10,7 +10,7 @@
 
 #include <cmocka.h>
 
-#include "umbra/umbra.h"
+#include "umbra/io.h"
 
 /* A context on PoCL's CPU device (or $UMBRA_DEVICE); fails the test if none can be made. The
  * PoCL cache goes to the build tree when ctest sets POCL_CACHE_DIR. */

@@ -6,9 +6,8 @@
 #ifndef UMBRA_CONTEXT_H
 #define UMBRA_CONTEXT_H
 
-#ifndef CL_TARGET_OPENCL_VERSION
-#define CL_TARGET_OPENCL_VERSION 120
-#endif
+/* umbra defines no CL_TARGET_OPENCL_VERSION for the application: it uses OpenCL 1.2 calls only,
+ * and any newer target the application chooses compiles against these declarations. */
 #include <CL/cl.h>
 #include <stddef.h>
 
@@ -45,45 +44,51 @@ typedef struct umbra_context_desc {
 } umbra_context_desc;
 
 /* Fills desc with the defaults. */
-void umbra_context_desc_init(umbra_context_desc *desc);
+UMBRA_API void umbra_context_desc_init(umbra_context_desc *desc);
 
 /* Creates a context on the device desc selects (desc may be NULL for defaults). On failure *out is
  * NULL and the reason went to desc->error_callback, if any. Blocks while OpenCL initialises. */
-umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context *out);
+UMBRA_API umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context *out);
 
 /* Creates a context on the application's OpenCL objects, which are retained (never released
  * beyond that retain, never destroyed). queue must belong to cl_ctx and device. */
-umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device,
-                                          cl_command_queue queue,
-                                          const umbra_context_desc *desc, umbra_context *out);
+UMBRA_API umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device,
+                                                    cl_command_queue queue,
+                                                    const umbra_context_desc *desc, umbra_context *out);
 
-void umbra_context_retain(umbra_context ctx);
+UMBRA_API void umbra_context_retain(umbra_context ctx);
 /* Drops one reference; the context is destroyed when the last umbra object using it is gone.
  * NULL is a no-op. */
-void umbra_context_release(umbra_context ctx);
+UMBRA_API void umbra_context_release(umbra_context ctx);
 
 /* Returns the first error recorded since the last call (UMBRA_SUCCESS if none) and clears it. If
  * message is not NULL it receives that error's message, owned by the context and valid until the
  * next call on this context. */
-umbra_status umbra_context_take_error(umbra_context ctx, const char **message);
+UMBRA_API umbra_status umbra_context_take_error(umbra_context ctx, const char **message);
 
 /* The message of the most recent error, or "" if none; owned by the context, valid until the next
  * failing call. */
-const char *umbra_context_last_message(umbra_context ctx);
+UMBRA_API const char *umbra_context_last_message(umbra_context ctx);
+
+/* Records an error on ctx exactly as umbra's own functions do (sticky first error, last message,
+ * callback) and returns status. For layers built on the public API, such as umbra_io; message is
+ * copied (truncated to 8191 bytes). ctx NULL: nothing is recorded. */
+UMBRA_API umbra_status umbra_context_record_error(umbra_context ctx, umbra_status status,
+                                                  const char *message);
 
 /* Installs (or with NULL removes) the error callback. */
-void umbra_context_set_error_callback(umbra_context ctx, umbra_error_callback cb, void *user);
+UMBRA_API void umbra_context_set_error_callback(umbra_context ctx, umbra_error_callback cb, void *user);
 
 /* "platform / device" names, owned by the context. */
-const char *umbra_context_device_name(umbra_context ctx);
+UMBRA_API const char *umbra_context_device_name(umbra_context ctx);
 
 /* The sampler back end actually in use (never AUTO). */
-umbra_sampler_kind umbra_context_sampler(umbra_context ctx);
+UMBRA_API umbra_sampler_kind umbra_context_sampler(umbra_context ctx);
 
 /* The OpenCL objects in use (borrowed: retain them to keep them). */
-cl_context umbra_context_cl_context(umbra_context ctx);
-cl_device_id umbra_context_cl_device(umbra_context ctx);
-cl_command_queue umbra_context_cl_queue(umbra_context ctx);
+UMBRA_API cl_context umbra_context_cl_context(umbra_context ctx);
+UMBRA_API cl_device_id umbra_context_cl_device(umbra_context ctx);
+UMBRA_API cl_command_queue umbra_context_cl_queue(umbra_context ctx);
 
 #ifdef __cplusplus
 }

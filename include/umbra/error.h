@@ -6,6 +6,8 @@
 #ifndef UMBRA_ERROR_H
 #define UMBRA_ERROR_H
 
+#include "umbra/config.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -23,7 +25,14 @@ typedef enum umbra_status {
 } umbra_status;
 
 /* Static English name of a status ("UMBRA_ERROR_IO"); never NULL. */
-const char *umbra_status_to_string(umbra_status status);
+UMBRA_API const char *umbra_status_to_string(umbra_status status);
+
+/* The library's version at run time, "MAJOR.MINOR.PATCH" (static storage); compare with
+ * UMBRA_VERSION_STRING, the version the application was compiled against. */
+UMBRA_API const char *umbra_version(void);
+
+/* The same as MAJOR * 10000 + MINOR * 100 + PATCH (see UMBRA_VERSION). */
+UMBRA_API unsigned umbra_version_number(void);
 
 /* Called for every error as it is recorded, on the calling thread. message is valid only during
  * the call. */

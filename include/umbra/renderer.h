@@ -47,7 +47,7 @@ typedef struct umbra_camera {
 
 /* A camera looking at the volume's centre from direction dir (need not be normalised) at a
  * distance that frames a box of the given diagonal. */
-umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees);
+UMBRA_API umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees);
 
 typedef enum umbra_light_type {
     UMBRA_LIGHT_POINT = 0,
@@ -85,7 +85,7 @@ typedef struct umbra_render_desc {
     umbra_transmission transmission; /* default UMBRA_TRANSMISSION_GREY */
 } umbra_render_desc;
 
-void umbra_render_desc_init(umbra_render_desc *desc);
+UMBRA_API void umbra_render_desc_init(umbra_render_desc *desc);
 
 typedef enum umbra_shadow_technique {
     UMBRA_SHADOW_NONE = 0,       /* shadow factor 1 everywhere */
@@ -97,9 +97,9 @@ typedef enum umbra_shadow_technique {
 } umbra_shadow_technique;
 
 /* Name used by the CLI ("reference"), or NULL for an unknown value. */
-const char *umbra_shadow_technique_name(umbra_shadow_technique technique);
+UMBRA_API const char *umbra_shadow_technique_name(umbra_shadow_technique technique);
 /* Parses a name; UMBRA_ERROR_INVALID_ARGUMENT for an unknown one. */
-umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
+UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
 
 typedef struct umbra_shadow_desc {
     size_t struct_size;          /* sizeof(umbra_shadow_desc); set by umbra_shadow_desc_init */
@@ -146,39 +146,39 @@ typedef struct umbra_shadow_desc {
                                     light over per slice, [0, 60] (default 5; 0: no blur) */
 } umbra_shadow_desc;
 
-void umbra_shadow_desc_init(umbra_shadow_desc *desc);
+UMBRA_API void umbra_shadow_desc_init(umbra_shadow_desc *desc);
 
 /* Creates a renderer on ctx (retained). */
-umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out);
-void umbra_renderer_retain(umbra_renderer r);
-void umbra_renderer_release(umbra_renderer r); /* NULL is a no-op */
+UMBRA_API umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out);
+UMBRA_API void umbra_renderer_retain(umbra_renderer r);
+UMBRA_API void umbra_renderer_release(umbra_renderer r); /* NULL is a no-op */
 
 /* The volume and transfer functions are retained. The light transfer function drives the light
  * pass (and the transmission colour); NULL (the default) uses the view transfer function. */
-umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume);
-umbra_status umbra_renderer_set_transfer_function(umbra_renderer r, umbra_transfer_function tf);
-umbra_status umbra_renderer_set_light_transfer_function(umbra_renderer r,
-                                                        umbra_transfer_function tf);
+UMBRA_API umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume);
+UMBRA_API umbra_status umbra_renderer_set_transfer_function(umbra_renderer r, umbra_transfer_function tf);
+UMBRA_API umbra_status umbra_renderer_set_light_transfer_function(umbra_renderer r,
+                                                                  umbra_transfer_function tf);
 /* Camera, light, options and shadow descriptions are copied and validated. */
-umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *camera);
-umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *light);
-umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_desc *desc);
-umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *desc);
+UMBRA_API umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *camera);
+UMBRA_API umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *light);
+UMBRA_API umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_desc *desc);
+UMBRA_API umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *desc);
 
 /* Renders width x height premultiplied RGBA floats, row 0 at the top, into rgba (4*w*h floats,
  * borrowed). Blocks until done. */
-umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height,
-                                   float *rgba);
+UMBRA_API umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height,
+                                             float *rgba);
 
 /* Renders into the application's buffer (retained during the call; at least 16*w*h bytes, same
  * layout as above). Blocks until done. */
-umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
-                                                cl_mem rgba);
+UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
+                                                          cl_mem rgba);
 
 /* Evaluates the current technique's shadow factor at count world-space points (3 floats each,
  * borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
-umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
-                                         float *rgb);
+UMBRA_API umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
+                                                   float *rgb);
 
 typedef struct umbra_render_stats {
     double shadow_build_ms;      /* device time of the last shadow build (0 if it was reused) */
@@ -191,7 +191,7 @@ typedef struct umbra_render_stats {
     uint64_t samples;            /* view samples taken in the last render (skipped ones excluded) */
 } umbra_render_stats;
 
-umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
+UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
 
 #ifdef __cplusplus
 }

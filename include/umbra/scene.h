@@ -23,14 +23,14 @@ typedef struct umbra_scene {
 } umbra_scene;
 
 /* Names of the built-in scenes, NULL-terminated. */
-const char *const *umbra_scene_names(void);
+UMBRA_API const char *const *umbra_scene_names(void);
 
 /* Builds scene name at resolution^3 voxels (0: the scene's default) on ctx. */
-umbra_status umbra_scene_create(umbra_context ctx, const char *name, uint32_t resolution,
-                                umbra_scene *out);
+UMBRA_API umbra_status umbra_scene_create(umbra_context ctx, const char *name, uint32_t resolution,
+                                          umbra_scene *out);
 
 /* Releases the scene's volume and transfer function and zeroes it; NULL is a no-op. */
-void umbra_scene_release(umbra_scene *scene);
+UMBRA_API void umbra_scene_release(umbra_scene *scene);
 
 #ifdef __cplusplus
 }

@@ -20,8 +20,8 @@ extern "C" {
 typedef struct umbra_transfer_function_t *umbra_transfer_function;
 
 /* Copies count RGBA entries (4*count floats, each finite and in [0,1]), count >= 2. */
-umbra_status umbra_transfer_function_create(umbra_context ctx, const float *rgba, uint32_t count,
-                                            umbra_transfer_function *out);
+UMBRA_API umbra_status umbra_transfer_function_create(umbra_context ctx, const float *rgba, uint32_t count,
+                                                      umbra_transfer_function *out);
 
 /* A control point: value in [0,1] of the normalised range, colour and opacity in [0,1]. */
 typedef struct umbra_tf_point {
@@ -31,27 +31,21 @@ typedef struct umbra_tf_point {
 
 /* Builds a table of resolution entries by linear interpolation between points (sorted by value,
  * at least one). Values outside the first and last point take those points' colours. */
-umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
-                                                        const umbra_tf_point *points,
-                                                        uint32_t count, uint32_t resolution,
-                                                        umbra_transfer_function *out);
+UMBRA_API umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
+                                                                  const umbra_tf_point *points,
+                                                                  uint32_t count, uint32_t resolution,
+                                                                  umbra_transfer_function *out);
 
-/* Reads the text format documented in the README (and host/tf_file.c): '#' comments, an optional
- * line "resolution N" (default 256) before the first point, then one control point
- * "value r g b a" per line, values ascending (equal values make a step). */
-umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
-                                          umbra_transfer_function *out);
-
-uint32_t umbra_transfer_function_size(umbra_transfer_function tf);
+UMBRA_API uint32_t umbra_transfer_function_size(umbra_transfer_function tf);
 /* The table, 4*size floats, owned by tf. */
-const float *umbra_transfer_function_data(umbra_transfer_function tf);
+UMBRA_API const float *umbra_transfer_function_data(umbra_transfer_function tf);
 
 /* Nonzero when every entry with alpha > 0 has r == g == b: such a function, used as the light
  * transfer function, attenuates all colours alike and needs one light channel, not three. */
-int umbra_transfer_function_is_grey(umbra_transfer_function tf);
+UMBRA_API int umbra_transfer_function_is_grey(umbra_transfer_function tf);
 
-void umbra_transfer_function_retain(umbra_transfer_function tf);
-void umbra_transfer_function_release(umbra_transfer_function tf); /* NULL is a no-op */
+UMBRA_API void umbra_transfer_function_retain(umbra_transfer_function tf);
+UMBRA_API void umbra_transfer_function_release(umbra_transfer_function tf); /* NULL is a no-op */
 
 #ifdef __cplusplus
 }

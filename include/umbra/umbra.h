@@ -1,5 +1,6 @@
 /* umbra/umbra.h: the whole public API of umbra, an OpenCL library for shadows in direct volume
- * rendering. Include this, or the one header per concept it lists. */
+ * rendering. Include this, or the one header per concept it lists. The optional file layer
+ * (umbra_io: NRRD, .dat, raw, transfer-function files, PNG/EXR) has its own header, umbra/io.h. */
 #ifndef UMBRA_UMBRA_H
 #define UMBRA_UMBRA_H
 
@@ -9,10 +10,5 @@
 #include "umbra/transfer_function.h"
 #include "umbra/renderer.h"
 #include "umbra/scene.h"
-#include "umbra/image.h"
-
-#define UMBRA_VERSION_MAJOR 0
-#define UMBRA_VERSION_MINOR 1
-#define UMBRA_VERSION_PATCH 0
 
 #endif

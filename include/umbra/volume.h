@@ -26,7 +26,7 @@ typedef enum umbra_scalar_type {
 } umbra_scalar_type;
 
 /* Bytes per voxel of type, or 0 for an unknown type. */
-size_t umbra_scalar_type_size(umbra_scalar_type type);
+UMBRA_API size_t umbra_scalar_type_size(umbra_scalar_type type);
 
 typedef struct umbra_volume_desc {
     size_t struct_size;      /* sizeof(umbra_volume_desc); set by umbra_volume_desc_init */
@@ -39,40 +39,11 @@ typedef struct umbra_volume_desc {
     uint32_t brick_size;     /* edge of an empty-space-skipping brick in voxels (default 16) */
 } umbra_volume_desc;
 
-void umbra_volume_desc_init(umbra_volume_desc *desc);
+UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
 /* Copies the data to the device. Blocks until the upload is done. */
-umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
-                                 umbra_volume *out);
-
-/* Loads a volume by file extension: .nrrd / .nhdr (Teem), .dat (Voreen). */
-umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
-
-/* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
- * short and float; 3-D, or 4-D with a size-1 first axis. Spacing comes from the header's spacings
- * or space directions (1 where absent). */
-umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
-
-/* Loads a Voreen .dat header and its raw file, which is looked up relative to the .dat's
- * directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
- * are required; ObjectModel, if present, must be I. */
-umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
-
-typedef struct umbra_raw_desc {
-    size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */
-    umbra_scalar_type type;
-    uint32_t dims[3];
-    float spacing[3];        /* default 1 */
-    int big_endian;          /* 0 (default): little-endian */
-    size_t header_bytes;     /* bytes to skip at the start of the file (default 0) */
-} umbra_raw_desc;
-
-void umbra_raw_desc_init(umbra_raw_desc *desc);
-
-/* Loads a headerless raw file. The file must hold exactly header_bytes + dims product * type size
- * bytes; any other size is UMBRA_ERROR_FORMAT naming both numbers. */
-umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
-                                   umbra_volume *out);
+UMBRA_API umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
+                                           umbra_volume *out);
 
 typedef struct umbra_volume_info {
     uint32_t dims[3];
@@ -84,10 +55,10 @@ typedef struct umbra_volume_info {
     size_t device_bytes;     /* device memory held by the volume and its brick table */
 } umbra_volume_info;
 
-umbra_status umbra_volume_get_info(umbra_volume volume, umbra_volume_info *out);
+UMBRA_API umbra_status umbra_volume_get_info(umbra_volume volume, umbra_volume_info *out);
 
-void umbra_volume_retain(umbra_volume volume);
-void umbra_volume_release(umbra_volume volume); /* NULL is a no-op */
+UMBRA_API void umbra_volume_retain(umbra_volume volume);
+UMBRA_API void umbra_volume_release(umbra_volume volume); /* NULL is a no-op */
 
 #ifdef __cplusplus
 }

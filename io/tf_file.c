@@ -1,4 +1,4 @@
-/* host/tf_file.c: reading transfer functions from text files.
+/* io/tf_file.c: reading transfer functions from text files.
  *
  * The format, one item per line:
  *     # a comment, to the end of the line (also after a value)
@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "io_internal.h"
 
 #define TF_DEFAULT_RESOLUTION 256u
 #define TF_MIN_RESOLUTION 2

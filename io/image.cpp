@@ -1,4 +1,4 @@
-// host/image.cpp: writing and reading images through OpenImageIO.
+// io/image.cpp: writing and reading images through OpenImageIO.
 //
 // umbra renders premultiplied linear RGBA floats. EXR stores them as they are. PNG cannot: it
 // holds unassociated 8-bit values, by convention sRGB-encoded, so writing un-premultiplies,
@@ -24,9 +24,7 @@
 
 #include "umbra/umbra.h"
 
-extern "C" {
-#include "internal.h"
-}
+#include "io_internal.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-/* host/io_volume.c: reading volumes from files.
+/* io/volume_io.c: reading volumes from files.
  *
  * Three readers, all ending in umbra_volume_create: NRRD through Teem (attached .nrrd or detached
  * .nhdr), Voreen's .dat text header over a raw file, and plain headerless raw files described by
@@ -24,7 +24,7 @@
 
 #include <teem/nrrd.h>
 
-#include "internal.h"
+#include "io_internal.h"
 
 /* Messages quote at most this much of a value taken from a file. */
 #define QUOTE_MAX 200

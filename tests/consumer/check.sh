@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# tests/consumer/check.sh SOURCE_DIR BUILD_DIR: umbra as an application takes it in.
+#  1. `cmake --install` into a fresh prefix; nothing installed names the source or build tree.
+#  2. The consumers (a copy of this folder, outside the source tree) build and run against the
+#     prefix alone through find_package(umbra), then through pkg-config (umbra, umbra-io, and the
+#     static libraries with --static), then with umbra as an add_subdirectory of theirs.
+#  3. A program linked only against umbra::umbra loads no OpenImageIO, Teem, ffmpeg or GDAL.
+#  4. The shared libraries export the public umbra_* API and nothing else.
+set -euo pipefail
+src=$(cd "$1" && pwd)
+build=$(cd "$2" && pwd)
+work=$(mktemp -d "${TMPDIR:-/tmp}/umbra-consumer.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+fail() { echo "check.sh: FAIL: $*" >&2; exit 1; }
+jobs=$(nproc 2>/dev/null || echo 2)
+
+echo "== install into a fresh prefix"
+prefix=$work/prefix
+cmake --install "$build" --prefix "$prefix" >/dev/null
+libdir=$(dirname "$(find "$prefix" -name 'libumbra.so' | head -n1)")
+[ -n "$libdir" ] || fail "no libumbra.so installed"
+for f in libumbra.so libumbra.a libumbra_io.so libumbra_io.a cmake/umbra/umbraConfig.cmake \
+         cmake/umbra/umbraConfigVersion.cmake pkgconfig/umbra.pc pkgconfig/umbra-io.pc; do
+  [ -e "$libdir/$f" ] || fail "not installed: $libdir/$f"
+done
+soname=$(objdump -p "$libdir/libumbra.so" | awk '/SONAME/ {print $2}')
+case "$soname" in libumbra.so.[0-9]*) ;; *) fail "libumbra.so has no versioned soname ($soname)";; esac
+for f in umbra.h io.h config.h context.h; do
+  [ -f "$prefix/include/umbra/$f" ] || fail "header not installed: include/umbra/$f"
+done
+[ -x "$prefix/bin/umbra-render" ] || fail "umbra-render not installed"
+"$prefix/bin/umbra-render" --version | grep -q "umbra-render" || fail "umbra-render --version"
+if grep -rIl -e "$src" -e "$build" "$prefix/include" "$libdir/cmake" "$libdir/pkgconfig"; then
+  fail "the files above name the source or build tree"
+fi
+cp -r "$src/tests/consumer" "$work/consumer"
+
+echo "== find_package(umbra) from the prefix"
+cmake -S "$work/consumer" -B "$work/fp" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/fp" -j"$jobs" >/dev/null
+"$work/fp/consumer_c"
+"$work/fp/consumer_cxx" "$work/fp.png"
+[ -s "$work/fp.png" ] || fail "consumer_cxx wrote no image"
+
+echo "== pkg-config"
+export PKG_CONFIG_PATH=$libdir/pkgconfig
+cc -std=c11 -Wall -Wextra -Werror -o "$work/pc_c" "$work/consumer/consumer.c" \
+   $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir"
+"$work/pc_c"
+c++ -std=c++17 -Wall -Wextra -Werror -DCL_TARGET_OPENCL_VERSION=300 -o "$work/pc_cxx" \
+    "$work/consumer/consumer.cpp" $(pkg-config --cflags --libs umbra-io) -Wl,-rpath,"$libdir"
+"$work/pc_cxx" "$work/pc.png"
+# The static libraries, with what they need from pkg-config --static.
+cc -std=c11 -o "$work/pc_static" "$work/consumer/consumer.c" \
+   $(pkg-config --cflags umbra) "$libdir/libumbra.a" $(pkg-config --static --libs-only-l umbra | sed 's/-lumbra//')
+"$work/pc_static"
+
+echo "== add_subdirectory(umbra)"
+cmake -S "$work/consumer" -B "$work/sub" -DUMBRA_SOURCE_DIR="$src" \
+      -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/sub" -j"$jobs" >/dev/null
+"$work/sub/consumer_c"
+"$work/sub/consumer_cxx" "$work/sub.png"
+for t in umbra-render umbra-bench test_io; do
+  [ ! -e "$work/sub/umbra/$t" ] || fail "add_subdirectory built $t (only the libraries expected)"
+done
+
+echo "== a program on umbra::umbra alone loads no I/O library"
+deps=$(ldd "$work/fp/consumer_c")
+if grep -Eqi 'OpenImageIO|teem|avcodec|avformat|gdal|opencv|dcmtk|openvdb' <<<"$deps"; then
+  echo "$deps" >&2
+  fail "consumer_c loads an I/O dependency"
+fi
+echo "consumer_c loads $(grep -c '=>' <<<"$deps") shared libraries"
+"$work/fp/consumer_c" --idle
+"$work/fp/consumer_cxx" --help >/dev/null 2>&1 || true
+
+echo "== exports"
+for lib in libumbra.so libumbra_io.so; do
+  bad=$(nm -D --defined-only "$libdir/$lib" | awk '$2 ~ /^[TDBRVW]$/ {print $3}' | grep -v '^umbra_' || true)
+  internal=$(nm -D --defined-only "$libdir/$lib" | awk '{print $3}' | grep '^umbra__' || true)
+  [ -z "$bad$internal" ] || { echo "$bad$internal" >&2; fail "$lib exports more than the public API"; }
+  echo "$lib exports $(nm -D --defined-only "$libdir/$lib" | grep -c ' umbra_') umbra_* symbols"
+done
+echo "check.sh: all consumers built and ran"
