@@ -388,7 +388,7 @@ static void test_async_render_waits_for_user_event_and_equals_blocking(void **st
     float *want = malloc(n * sizeof *want), *got = malloc(n * sizeof *got);
     assert_non_null(want);
     assert_non_null(got);
-    alarm(300); /* a call that blocked on the user event would hang: fail instead */
+    alarm(120); /* a call that blocked on the user event would hang: fail instead */
     for (int kind = 0; kind < 2; ++kind) {
         app_cl app;
         if (!app_open(own, kind ? CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE : 0, &app))
@@ -452,7 +452,7 @@ static void test_async_frames_pipeline_without_waiting(void **state)
     cl_mem buf[2] = {app_buffer(&app, CL_MEM_READ_WRITE, n * sizeof(float)),
                      app_buffer(&app, CL_MEM_READ_WRITE, n * sizeof(float))};
     const tech_case *tcs[2] = {&cases[3], &cases[6]}; /* threshold (ray caster), convolution */
-    alarm(300); /* the second call blocking on the first frame's user event would hang */
+    alarm(120); /* the second call blocking on the first frame's user event would hang */
     for (int t = 0; t < 2; ++t) {
         umbra_scene sc;
         umbra_renderer r = case_renderer(ctx, tcs[t], &sc);
@@ -505,7 +505,7 @@ static void test_async_frame_survives_release_of_everything(void **state)
     float *want = malloc(n * sizeof *want), *got = malloc(n * sizeof *got);
     assert_non_null(want);
     assert_non_null(got);
-    alarm(300);
+    alarm(120);
     for (int kind = 0; kind < 2; ++kind) {
         app_cl app;
         if (!app_open(own, kind ? CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE : 0, &app))
