@@ -3,9 +3,15 @@
  *
  * Device choice, in order: desc's platform/device indices or name substring; else, with
  * use_environment, $UMBRA_DEVICE ("P:D" indices or a name substring); else the first GPU, else
- * the first device of any type. PoCL needs a writable kernel cache: unless $POCL_CACHE_DIR is set,
- * it is pointed at desc->cache_dir or a directory under $TMPDIR (or /tmp) before OpenCL starts,
- * so a user whose HOME is read-only still gets a working context. */
+ * the first device of any type. PoCL needs a writable kernel cache: with set_pocl_cache_dir and
+ * unless $POCL_CACHE_DIR is set, it is pointed at desc->cache_dir or a directory under $TMPDIR
+ * (or /tmp) before OpenCL starts, so a user whose HOME is read-only still gets a working context.
+ *
+ * umbra's host code relies on its commands running in the order it enqueues them (a kernel reads
+ * what the previous one wrote; a blocking read follows the kernel it reads). On an application's
+ * out-of-order queue that order does not hold, so umbra makes its own in-order queue on the
+ * application's context and device and enqueues there (include/umbra/context.h, "The OpenCL
+ * contract"). */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -34,6 +40,7 @@ void umbra_context_desc_init(umbra_context_desc *desc)
     desc->device_index = -1;
     desc->use_environment = 1;
     desc->sampler = UMBRA_SAMPLER_AUTO;
+    desc->set_pocl_cache_dir = 1;
 }
 
 static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
@@ -50,10 +57,11 @@ static void report(const umbra_context_desc *desc, umbra_status st, const char *
     desc->error_callback(desc->error_user, st, msg);
 }
 
-/* PoCL reads POCL_CACHE_DIR when the platform initialises; set it only if the user has not. */
+/* PoCL reads POCL_CACHE_DIR when the platform initialises; set it only if the user has not, and
+ * only if the application lets umbra touch its environment. */
 static void prepare_pocl_cache(const umbra_context_desc *desc)
 {
-    if (getenv("POCL_CACHE_DIR"))
+    if (!desc->set_pocl_cache_dir || getenv("POCL_CACHE_DIR"))
         return;
     char dir[1024];
     if (desc && desc->cache_dir) {
@@ -200,17 +208,29 @@ static umbra_status context_alloc(const umbra_context_desc *desc, umbra_context 
     return UMBRA_SUCCESS;
 }
 
-static int desc_ok(const umbra_context_desc *desc)
+/* The size of umbra_context_desc before set_pocl_cache_dir was added: callers built against that
+ * layout are still accepted and get the new fields' defaults. */
+#define DESC_SIZE_V1 offsetof(umbra_context_desc, set_pocl_cache_dir)
+
+/* Checks desc and copies it, completed with defaults for fields an older layout lacks, into
+ * *full (the defaults when desc is NULL). */
+static int desc_ok(const umbra_context_desc *desc, umbra_context_desc *full)
 {
-    if (desc && desc->struct_size != sizeof *desc) {
+    umbra_context_desc_init(full);
+    if (!desc)
+        return 1;
+    if (desc->struct_size != sizeof *desc && desc->struct_size != DESC_SIZE_V1) {
         report(desc, UMBRA_ERROR_INVALID_ARGUMENT,
-               "umbra_context_create: desc->struct_size %zu != %zu: call umbra_context_desc_init",
-               desc->struct_size, sizeof *desc);
+               "umbra_context_create: desc->struct_size %zu is neither %zu nor the older %zu: "
+               "call umbra_context_desc_init", desc->struct_size, sizeof *desc,
+               (size_t)DESC_SIZE_V1);
         return 0;
     }
-    if (desc && (desc->sampler < UMBRA_SAMPLER_AUTO || desc->sampler > UMBRA_SAMPLER_IMAGE)) {
+    memcpy(full, desc, desc->struct_size);
+    full->struct_size = sizeof *full;
+    if (full->sampler < UMBRA_SAMPLER_AUTO || full->sampler > UMBRA_SAMPLER_IMAGE) {
         report(desc, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_context_create: sampler %d is unknown",
-               (int)desc->sampler);
+               (int)full->sampler);
         return 0;
     }
     return 1;
@@ -223,13 +243,10 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
         return UMBRA_ERROR_INVALID_ARGUMENT;
     }
     *out = NULL;
-    if (!desc_ok(desc))
+    umbra_context_desc full;
+    if (!desc_ok(desc, &full))
         return UMBRA_ERROR_INVALID_ARGUMENT;
-    umbra_context_desc defaults;
-    if (!desc) {
-        umbra_context_desc_init(&defaults);
-        desc = &defaults;
-    }
+    desc = &full;
     prepare_pocl_cache(desc);
 
     umbra_context ctx = NULL;
@@ -244,6 +261,7 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
     UMBRA_CL_CHECK(err, "clCreateContext");
     ctx->queue = clCreateCommandQueue(ctx->cl_ctx, ctx->device, CL_QUEUE_PROFILING_ENABLE, &err);
     UMBRA_CL_CHECK(err, "clCreateCommandQueue");
+    ctx->profiling = 1;
     describe_device(ctx, desc);
     *out = ctx;
     return UMBRA_SUCCESS;
@@ -263,12 +281,17 @@ umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device
         return UMBRA_ERROR_INVALID_ARGUMENT;
     }
     *out = NULL;
-    if (!desc_ok(desc))
+    umbra_context_desc full;
+    if (!desc_ok(desc, &full))
         return UMBRA_ERROR_INVALID_ARGUMENT;
+    desc = &full;
     cl_context qctx = NULL;
     cl_device_id qdev = NULL;
+    cl_command_queue_properties props = 0;
     if (clGetCommandQueueInfo(queue, CL_QUEUE_CONTEXT, sizeof qctx, &qctx, NULL) != CL_SUCCESS ||
         clGetCommandQueueInfo(queue, CL_QUEUE_DEVICE, sizeof qdev, &qdev, NULL) != CL_SUCCESS ||
+        clGetCommandQueueInfo(queue, CL_QUEUE_PROPERTIES, sizeof props, &props, NULL) !=
+            CL_SUCCESS ||
         qctx != cl_ctx || qdev != device) {
         report(desc, UMBRA_ERROR_INVALID_ARGUMENT,
                "umbra_context_create_from_cl: queue %p does not belong to context %p and device %p",
@@ -280,14 +303,35 @@ umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device
     if (st != UMBRA_SUCCESS)
         return st;
     clRetainContext(cl_ctx);
-    clRetainCommandQueue(queue);
     ctx->cl_ctx = cl_ctx;
-    ctx->queue = queue;
     ctx->device = device;
+    if (props & CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE) {
+        /* umbra's commands depend on each other in enqueue order: they go to an in-order queue
+         * of umbra's own (with profiling, so the stats get device times). */
+        cl_int err;
+        ctx->queue = clCreateCommandQueue(cl_ctx, device, CL_QUEUE_PROFILING_ENABLE, &err);
+        if (err != CL_SUCCESS) {
+            ctx->queue = NULL;
+            st = umbra__fail_cl(ctx, __func__,
+                                "clCreateCommandQueue (an in-order queue beside the application's "
+                                "out-of-order queue)", err, __FILE__, __LINE__);
+            goto fail; /* the error callback (from desc) has seen it */
+        }
+        clRetainCommandQueue(queue);
+        ctx->app_queue = queue;
+        ctx->profiling = 1;
+    } else {
+        clRetainCommandQueue(queue);
+        ctx->queue = queue;
+        ctx->profiling = (props & CL_QUEUE_PROFILING_ENABLE) != 0;
+    }
     clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof ctx->platform, &ctx->platform, NULL);
     describe_device(ctx, desc);
     *out = ctx;
     return UMBRA_SUCCESS;
+fail:
+    umbra_context_release(ctx);
+    return st;
 }
 
 void umbra_context_retain(umbra_context ctx)
@@ -309,6 +353,8 @@ void umbra_context_release(umbra_context ctx)
     }
     if (ctx->queue)
         clReleaseCommandQueue(ctx->queue);
+    if (ctx->app_queue)
+        clReleaseCommandQueue(ctx->app_queue);
     if (ctx->cl_ctx)
         clReleaseContext(ctx->cl_ctx);
     free(ctx);

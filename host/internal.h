@@ -62,7 +62,10 @@ struct umbra_context_t {
     cl_platform_id platform;
     cl_context cl_ctx;
     cl_device_id device;
-    cl_command_queue queue;
+    cl_command_queue queue;             /* where umbra enqueues: in-order, always */
+    cl_command_queue app_queue;         /* the application's out-of-order queue, retained, when
+                                           umbra runs on its own in-order queue; else NULL */
+    int profiling;                      /* queue has CL_QUEUE_PROFILING_ENABLE: device times */
     int is_cpu;
     int has_float_r_image3d;
     umbra_sampler_kind sampler;
@@ -94,8 +97,9 @@ const char *umbra__kernel_source(const char *name);
 umbra_status umbra__enqueue(umbra_context ctx, cl_kernel k, cl_uint dim, const size_t *global,
                             const size_t *local, cl_event *event);
 
-/* Milliseconds between an event's start and end (profiling is enabled on umbra's own queues;
- * on an application queue without profiling, wall-clock time around clFinish is used). */
+/* Milliseconds between an event's start and end, or -1 without profiling (ctx->profiling is 0
+ * on an application's in-order queue without CL_QUEUE_PROFILING_ENABLE: callers then time the
+ * wall clock, and the stats say so). */
 double umbra__event_ms(cl_event ev);
 double umbra__now_ms(void);
 

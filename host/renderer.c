@@ -643,15 +643,34 @@ fail:
 umbra_status umbra__upload_params(umbra_renderer r)
 {
     umbra_context ctx = r->ctx;
-    umbra_status st = ensure_buffer(r, &r->frame_buf, sizeof(UmbraFrame), CL_MEM_READ_ONLY);
-    if (st == UMBRA_SUCCESS)
-        st = ensure_buffer(r, &r->shadow_buf, sizeof(UmbraShadow), CL_MEM_READ_ONLY);
-    if (st != UMBRA_SUCCESS)
-        return st;
-    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->frame_buf, CL_FALSE, 0, sizeof r->frame,
-                                  &r->frame, 0, NULL, NULL));
-    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->shadow_buf, CL_TRUE, 0, sizeof r->shadow_params,
-                                  &r->shadow_params, 0, NULL, NULL));
+    umbra_status st = UMBRA_SUCCESS;
+    cl_int err;
+    /* New buffers rather than writes into the old ones: a write from r->frame would have to wait
+     * (or r->frame stay unchanged) until it ran, and a frame still queued behind the application's
+     * wait list must keep its own constants. OpenCL frees the old buffers once the commands that
+     * use them have completed. */
+    release_mem(&r->frame_buf);
+    release_mem(&r->shadow_buf);
+    r->frame_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                  sizeof r->frame, &r->frame, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(frame constants)");
+    r->shadow_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                   sizeof r->shadow_params, &r->shadow_params, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(shadow constants)");
+fail:
+    return st;
+}
+
+umbra_status umbra__frame_gate(umbra_renderer r)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (!r->async || r->async->gated)
+        return UMBRA_SUCCESS;
+    if (r->async->num_wait)
+        UMBRA_CL(clEnqueueBarrierWithWaitList(ctx->queue, r->async->num_wait, r->async->wait_list,
+                                              NULL));
+    r->async->gated = 1;
 fail:
     return st;
 }
@@ -747,6 +766,13 @@ static umbra_status ensure_kernels(umbra_renderer r)
     return UMBRA_SUCCESS;
 }
 
+static umbra_timing measured_timing(umbra_renderer r)
+{
+    return r->ctx->profiling ? UMBRA_TIMING_DEVICE : UMBRA_TIMING_WALL;
+}
+
+/* Renders the frame into out. Blocking frames wait for it; asynchronous ones (r->async) only
+ * enqueue it, gated on their wait list. */
 static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out)
 {
     const char *fn = "umbra_renderer_render";
@@ -764,6 +790,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         return st;
     frame_update_view(r, width, height);
     r->stats.slices = 0;
+    r->stats.render_timing = r->async ? UMBRA_TIMING_NONE : measured_timing(r);
     if (r->tech->render) {
         st = umbra__upload_params(r);
         if (st == UMBRA_SUCCESS)
@@ -780,8 +807,6 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         return st;
     cl_ulong zero = 0;
     cl_uint next = 0;
-    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->samples_buf, CL_FALSE, 0, sizeof zero, &zero, 0,
-                                  NULL, NULL));
     st = umbra__bind_common(r, r->render_kernel, &next);
     if (st != UMBRA_SUCCESS)
         goto fail;
@@ -804,10 +829,20 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (r->tech->bind && (st = r->tech->bind(r, r->render_kernel, next)) != UMBRA_SUCCESS)
         goto fail;
     size_t global[2] = {width, height};
+    if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS)
+        goto fail;
+    /* A fill copies its pattern at the call: nothing points into this stack frame later. */
+    UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0, sizeof zero,
+                                 0, NULL, NULL));
     double t0 = umbra__now_ms();
     st = umbra__enqueue(ctx, r->render_kernel, 2, global, NULL, &ev);
     if (st != UMBRA_SUCCESS)
         goto fail;
+    if (r->async) {
+        r->stats.render_ms = 0.0;
+        r->stats.samples = 0;
+        goto fail; /* done: the caller marks the frame's end */
+    }
     UMBRA_CL(clWaitForEvents(1, &ev));
     double ms = umbra__event_ms(ev);
     r->stats.render_ms = ms >= 0.0 ? ms : umbra__now_ms() - t0;
@@ -855,6 +890,62 @@ fail:
     return st;
 }
 
+static const char *mem_type_name(cl_mem_object_type t)
+{
+    switch (t) {
+    case CL_MEM_OBJECT_BUFFER: return "buffer";
+    case CL_MEM_OBJECT_IMAGE2D: return "2D image";
+    case CL_MEM_OBJECT_IMAGE3D: return "3D image";
+    case CL_MEM_OBJECT_IMAGE2D_ARRAY: return "2D image array";
+    case CL_MEM_OBJECT_IMAGE1D: return "1D image";
+    case CL_MEM_OBJECT_IMAGE1D_ARRAY: return "1D image array";
+    case CL_MEM_OBJECT_IMAGE1D_BUFFER: return "1D image buffer";
+    default: return "memory object of unknown type";
+    }
+}
+
+/* The application's output buffer (context.h contract point 2): a buffer of this cl_context that
+ * kernels may write, of at least 16*w*h bytes. */
+static umbra_status check_app_buffer(umbra_renderer r, cl_mem rgba, uint32_t width,
+                                     uint32_t height, const char *fn)
+{
+    umbra_context ctx = r->ctx;
+    if (!rgba)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
+    size_t have = 0;
+    cl_context owner = NULL;
+    cl_mem_object_type type = 0;
+    cl_mem_flags flags = 0;
+    cl_int err = clGetMemObjectInfo(rgba, CL_MEM_TYPE, sizeof type, &type, NULL);
+    if (err == CL_SUCCESS)
+        err = clGetMemObjectInfo(rgba, CL_MEM_CONTEXT, sizeof owner, &owner, NULL);
+    if (err == CL_SUCCESS)
+        err = clGetMemObjectInfo(rgba, CL_MEM_SIZE, sizeof have, &have, NULL);
+    if (err == CL_SUCCESS)
+        err = clGetMemObjectInfo(rgba, CL_MEM_FLAGS, sizeof flags, &flags, NULL);
+    if (err != CL_SUCCESS)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: rgba %p is not a valid cl_mem (clGetMemObjectInfo: %s, %d)", fn,
+                           (void *)rgba, umbra__cl_error_name(err), (int)err);
+    if (owner != ctx->cl_ctx)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: rgba %p belongs to another cl_context (%p; the renderer's is %p)",
+                           fn, (void *)rgba, (void *)owner, (void *)ctx->cl_ctx);
+    if (type != CL_MEM_OBJECT_BUFFER)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: rgba %p is a %s (CL_MEM_TYPE 0x%x); a buffer is required", fn,
+                           (void *)rgba, mem_type_name(type), (unsigned)type);
+    if (flags & CL_MEM_READ_ONLY)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: rgba %p was created CL_MEM_READ_ONLY; kernels must write it", fn,
+                           (void *)rgba);
+    if (have < (size_t)width * height * 16)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: rgba %p holds %zu bytes; %u x %u RGBA floats need %zu", fn,
+                           (void *)rgba, have, width, height, (size_t)width * height * 16);
+    return UMBRA_SUCCESS;
+}
+
 umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
                                                 cl_mem rgba)
 {
@@ -862,28 +953,68 @@ umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width
     CHECK_R();
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    if (!rgba)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
-    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS)
+    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS ||
+        (st = check_app_buffer(r, rgba, width, height, fn)) != UMBRA_SUCCESS)
         return st;
-    size_t have = 0;
-    cl_context owner = NULL;
-    UMBRA_CL(clGetMemObjectInfo(rgba, CL_MEM_SIZE, sizeof have, &have, NULL));
-    UMBRA_CL(clGetMemObjectInfo(rgba, CL_MEM_CONTEXT, sizeof owner, &owner, NULL));
-    if (owner != ctx->cl_ctx)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: buffer belongs to another cl_context", fn);
-    if (have < (size_t)width * height * 16)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: buffer holds %zu bytes; %u x %u RGBA floats need %zu", fn, have,
-                           width, height, (size_t)width * height * 16);
     clRetainMemObject(rgba);
     st = render_into(r, width, height, rgba);
     if (st == UMBRA_SUCCESS)
         UMBRA_CL(clFinish(ctx->queue));
+fail:
     clReleaseMemObject(rgba);
     return st;
+}
+
+umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
+                                                      uint32_t height, cl_mem rgba,
+                                                      cl_uint num_wait, const cl_event *wait_list,
+                                                      cl_event *done)
+{
+    const char *fn = "umbra_renderer_render_to_cl_buffer_async";
+    CHECK_R();
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (!done)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: done is NULL", fn);
+    *done = NULL;
+    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS ||
+        (st = check_app_buffer(r, rgba, width, height, fn)) != UMBRA_SUCCESS)
+        return st;
+    if ((num_wait > 0) != (wait_list != NULL))
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: num_wait %u with wait_list %p: a list needs a count and a count "
+                           "a list", fn, num_wait, (const void *)wait_list);
+    for (cl_uint i = 0; i < num_wait; ++i) {
+        cl_context owner = NULL;
+        if (!wait_list[i] || clGetEventInfo(wait_list[i], CL_EVENT_CONTEXT, sizeof owner, &owner,
+                                            NULL) != CL_SUCCESS)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: wait_list[%u] %p is not a valid event", fn, i,
+                               (void *)wait_list[i]);
+        if (owner != ctx->cl_ctx)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: wait_list[%u] %p belongs to another cl_context (%p; the "
+                               "renderer's is %p)", fn, i, (void *)wait_list[i], (void *)owner,
+                               (void *)ctx->cl_ctx);
+    }
+    umbra__async async = {num_wait, wait_list, 0};
+    r->async = &async;
+    st = render_into(r, width, height, rgba);
+    r->async = NULL;
+    if (st != UMBRA_SUCCESS)
+        return st;
+    if (!async.gated)
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique '%s' enqueued its frame without the wait list's barrier",
+                           fn, umbra_shadow_technique_name(r->tech->id));
+    /* On the in-order queue, a marker completes once every command before it has. */
+    UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, done));
+    UMBRA_CL(clFlush(ctx->queue));
+    return UMBRA_SUCCESS;
 fail:
+    if (*done)
+        clReleaseEvent(*done);
+    *done = NULL;
     return st;
 }
 
@@ -942,6 +1073,7 @@ umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_get_stats: out is NULL");
     *out = r->stats;
+    out->shadow_build_timing = r->stats.shadow_rebuilt ? measured_timing(r) : UMBRA_TIMING_NONE;
     out->light_channels = r->tech->id == UMBRA_SHADOW_NONE ? 0
                           : r->tech->channels               ? r->tech->channels
                                                             : r->channels;

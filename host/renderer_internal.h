@@ -50,6 +50,14 @@ typedef struct umbra__light_key {
     int skip_empty;
 } umbra__light_key;
 
+/* An asynchronous frame (umbra_renderer_render_to_cl_buffer_async), set on the renderer for the
+ * duration of that call; NULL during the blocking calls. */
+typedef struct umbra__async {
+    cl_uint num_wait;
+    const cl_event *wait_list;
+    int gated;                               /* the wait list's barrier is enqueued */
+} umbra__async;
+
 struct umbra_renderer_t {
     int refs;
     umbra_context ctx;
@@ -83,6 +91,7 @@ struct umbra_renderer_t {
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
 
     umbra_render_stats stats;
+    umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
 };
 
 /* The light transfer function in effect (the view one unless a light one was set). */
@@ -99,7 +108,15 @@ void umbra__frame_update_light(umbra_renderer r);
  * r->light_cells_buf the visibility of each brick's sub-cells under it. */
 umbra_status umbra__light_tables(umbra_renderer r, float step_voxels);
 
-/* Uploads r->frame and r->shadow_params to the device. */
+/* Marks the point in a frame after which commands must wait for an asynchronous frame's wait
+ * list (a no-op for blocking frames): the renderer or technique calls it once, after everything
+ * that waits on the host (builds, blocking reads) and before the first command that writes the
+ * output. Enqueues a barrier on the wait list; the in-order queue holds everything after it. */
+umbra_status umbra__frame_gate(umbra_renderer r);
+
+/* Copies r->frame and r->shadow_params into fresh device buffers (r->frame_buf, r->shadow_buf):
+ * nothing waits on the queue, and commands already enqueued keep the constants they were
+ * enqueued with. */
 umbra_status umbra__upload_params(umbra_renderer r);
 
 /* The OpenCL build options every program of this renderer uses: the sampler and the number of

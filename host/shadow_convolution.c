@@ -351,6 +351,10 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra__convolution_light: slice %u requested; the frame has %u", last,
                            G.slices);
+    /* An asynchronous frame waits for the application from here on: everything above may
+     * block the host (the pre-integration tables), nothing below does. */
+    if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS)
+        return st;
     double t0 = umbra__now_ms();
     for (uint32_t i = 0; i < n; ++i) {
         ctl.s[0] = i;
@@ -376,7 +380,13 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof rect, &rect));
         if ((st = umbra__enqueue(ctx, s->resolve, 2, global, NULL, &end)))
             goto fail;
-        UMBRA_CL(clWaitForEvents(1, &end));
+        if (r->async) { /* the caller marks the frame's end; nothing is timed */
+            if (ms)
+                *ms = 0.0;
+            ms = NULL;
+        } else {
+            UMBRA_CL(clWaitForEvents(1, &end));
+        }
     } else {
         UMBRA_CL(clFinish(ctx->queue));
     }

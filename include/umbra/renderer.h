@@ -170,25 +170,61 @@ UMBRA_API umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_s
 UMBRA_API umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height,
                                              float *rgba);
 
-/* Renders into the application's buffer (retained during the call; at least 16*w*h bytes, same
- * layout as above). Blocks until done. */
+/* Renders into the application's buffer (retained during the call; a writable buffer of the
+ * context's cl_context of at least 16*w*h bytes, same layout as above; anything else is refused,
+ * context.h contract point 2). Blocks until done. */
 UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
                                                           cl_mem rgba);
+
+/* As umbra_renderer_render_to_cl_buffer, for applications that pipeline: the frame's commands
+ * wait for the num_wait events of wait_list (events of the context's cl_context, e.g. the
+ * application's user events or the commands that last wrote rgba; wait_list is borrowed, may be
+ * NULL when num_wait is 0) and *done receives a new event (the caller releases it) that completes
+ * when rgba holds the frame. On failure *done is NULL and rgba's contents are unspecified.
+ *
+ * What happens on the host before the call returns: whatever the frame needs that is not yet
+ * built is built and waited for, ahead of the wait list: kernel programs (the first use of a
+ * technique), step-corrected transfer-function tables, pre-integration tables and the shadow
+ * structure (after the light, volume, light transfer function or shadow description changed).
+ * Such a build waits for the commands already in the queue, which on an in-order application
+ * queue includes earlier asynchronous frames still waiting on their own wait lists: change the
+ * light only once those can complete. When nothing needs building (e.g. only the camera moved)
+ * the call waits for nothing. Per-frame constants are copied at the call; the renderer, volume,
+ * transfer functions and rgba may be changed or released as soon as it returns (OpenCL keeps
+ * what the enqueued commands use until they complete). The frame's stats have
+ * render_timing UMBRA_TIMING_NONE, render_ms 0 and samples 0 (the call does not wait for them);
+ * the device time is available from *done when the queue has profiling. */
+UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
+                                                                uint32_t height, cl_mem rgba,
+                                                                cl_uint num_wait, const cl_event *wait_list,
+                                                                cl_event *done);
 
 /* Evaluates the current technique's shadow factor at count world-space points (3 floats each,
  * borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
 UMBRA_API umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
                                                    float *rgb);
 
+/* Where a time in umbra_render_stats comes from (context.h contract point 4). */
+typedef enum umbra_timing {
+    UMBRA_TIMING_NONE = 0,   /* not measured (nothing was built, nothing rendered yet, or the
+                                frame was asynchronous): the time is 0 */
+    UMBRA_TIMING_DEVICE = 1, /* device time from the events' profiling counters */
+    UMBRA_TIMING_WALL = 2    /* host wall clock from enqueue to completion (a queue without
+                                CL_QUEUE_PROFILING_ENABLE): includes work queued ahead */
+} umbra_timing;
+
 typedef struct umbra_render_stats {
-    double shadow_build_ms;      /* device time of the last shadow build (0 if it was reused) */
-    double render_ms;            /* device time of the last render */
+    double shadow_build_ms;      /* time of the last shadow build (0 if it was reused), as
+                                    shadow_build_timing says */
+    double render_ms;            /* time of the last render, as render_timing says */
     int shadow_rebuilt;          /* nonzero if the last render rebuilt the shadow structure */
     size_t shadow_memory_bytes;  /* device memory the shadow structure holds */
     uint32_t light_channels;     /* 1 or 3: light channels the technique simulates */
     uint32_t slices;             /* convolution: slices in the last frame (each one kernel
                                     launch), else 0 */
     uint64_t samples;            /* view samples taken in the last render (skipped ones excluded) */
+    umbra_timing shadow_build_timing; /* what shadow_build_ms measures */
+    umbra_timing render_timing;  /* what render_ms measures */
 } umbra_render_stats;
 
 UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
