@@ -116,7 +116,20 @@ struct umbra_volume_t {
     cl_mem image;            /* CL_R / CL_FLOAT 3D image (image sampler), or NULL */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
+    /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
+     * box); the host maps world inputs into it. Without a transform (transformed 0) world and
+     * local coincide and the maps copy their input, so default scenes stay bit for bit. */
+    int transformed;
+    double origin[3];        /* world position of voxel (0, 0, 0)'s centre */
+    double axes[9];          /* orthonormal world direction of index axis a in axes[3a..3a+2] */
+    double centre0[3];       /* local position of voxel (0, 0, 0)'s centre: (0.5 - dims/2) spacing */
 };
+
+/* World -> local: l_a = axes_a . (w - origin) + centre0_a (points), axes_a . w (directions). */
+void umbra__volume_point_to_local(umbra_volume v, const float w[3], float out[3]);
+void umbra__volume_dir_to_local(umbra_volume v, const float w[3], float out[3]);
+/* Local -> world: origin + sum_a axes_a (l_a - centre0_a). */
+void umbra__volume_point_to_world(umbra_volume v, const float l[3], double out[3]);
 
 /* ---- transfer function ---------------------------------------------------------------------- */
 
