@@ -22,12 +22,13 @@ static void usage(FILE *f)
         "  --size WxH            image size (default 512x512)\n"
         "  --out FILE            output image, .png or .exr (default umbra.png)\n"
         "  --technique NAME      none | reference | threshold | deep | cssm | convolution\n"
-        "  --camera-dir X,Y,Z    orbit camera from this direction\n"
-        "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z   look-at camera\n"
+        "  --camera-dir X,Y,Z    orbit camera around the box's centre from this direction\n"
+        "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z   look-at camera, in the volume's world\n"
+        "                        (a NRRD's space; else the box is centred at 0)\n"
         "  --fov DEG             vertical field of view (default 30)\n"
         "  --ortho H             orthographic camera of view height H\n"
         "  --light-dir X,Y,Z     directional light travelling along X,Y,Z\n"
-        "  --light-pos X,Y,Z     point light at X,Y,Z (world units, volume centred at 0)\n"
+        "  --light-pos X,Y,Z     point light at X,Y,Z (the volume's world)\n"
         "  --light-color R,G,B   light colour (default 1,1,1)\n"
         "  --ambient A           ambient light (default 0.2)\n"
         "  --step S              view sampling step in voxels (default 0.5)\n"
@@ -263,7 +264,8 @@ static int run(const options *o, session *s)
         float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
                            info.extent[2] * info.extent[2]);
         const float dir[3] = {0.75f, 0.5f, 1.0f};
-        cam = umbra_camera_orbit(dir, diag, o->fov);
+        /* Around the box's world centre: a NRRD with a space origin is not centred on 0. */
+        cam = umbra_camera_orbit_at(info.center, dir, diag, o->fov);
         memset(&light, 0, sizeof light);
         light.type = UMBRA_LIGHT_DIRECTIONAL;
         light.direction[0] = 0.45f;
@@ -302,7 +304,7 @@ static int run(const options *o, session *s)
         umbra_volume_get_info(vol, &info);
         float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
                            info.extent[2] * info.extent[2]);
-        cam = umbra_camera_orbit(o->camera_dir, diag * 1.1f, o->fov);
+        cam = umbra_camera_orbit_at(info.center, o->camera_dir, diag * 1.1f, o->fov);
     }
     if (o->have_eye) memcpy(cam.eye, o->eye, sizeof cam.eye);
     if (o->have_target) memcpy(cam.target, o->target, sizeof cam.target);

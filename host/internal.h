@@ -139,8 +139,17 @@ struct umbra_transfer_function_t {
     uint32_t count;
     float *rgba;             /* host copy, 4*count */
     cl_mem buffer;           /* device copy, float4 per entry */
-    uint64_t id;             /* unique per table */
+    uint64_t id;             /* unique per table (and per range: set_range gives a new id) */
+    int range_given;         /* nonzero: the table spans data values range_lo..range_hi */
+    float range_lo, range_hi;
 };
+
+/* The table tf means for a volume whose normalised range [0,1] stands for data values
+ * value_min..value_max: tf itself (retained) when it has no data range, else a new table over
+ * [0,1] resampled from tf's range (values outside it take the end entries), fine enough that a
+ * step of tf widens by at most a quarter of one of tf's entries (up to 65536 entries). */
+umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
+                                  umbra_transfer_function *out);
 
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);

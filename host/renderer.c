@@ -219,6 +219,8 @@ void umbra_renderer_release(umbra_renderer r)
     umbra_volume_release(r->volume);
     umbra_transfer_function_release(r->tf);
     umbra_transfer_function_release(r->light_tf);
+    umbra_transfer_function_release(r->view_eff);
+    umbra_transfer_function_release(r->light_eff);
     umbra_context_release(r->ctx);
     free(r);
 }
@@ -417,7 +419,33 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
 
 /* ---- tables ---------------------------------------------------------------------------------------- */
 
-umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_tf ? r->light_tf : r->tf; }
+umbra_transfer_function umbra__view_tf(umbra_renderer r) { return r->view_eff; }
+umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_eff; }
+
+/* Keeps *eff equal to umbra__tf_for_volume(tf, volume), re-made when either changed. */
+static umbra_status effective_tf(umbra_renderer r, umbra_transfer_function tf,
+                                 umbra_transfer_function *eff, uint64_t key[2])
+{
+    const uint64_t want[2] = {tf->id, r->volume->id};
+    if (*eff && memcmp(want, key, sizeof want) == 0)
+        return UMBRA_SUCCESS;
+    umbra_transfer_function made = NULL;
+    umbra_status st = umbra__tf_for_volume(tf, r->volume->value_min, r->volume->value_max, &made);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    umbra_transfer_function_release(*eff);
+    *eff = made;
+    memcpy(key, want, sizeof want);
+    return UMBRA_SUCCESS;
+}
+
+static umbra_status effective_tfs(umbra_renderer r)
+{
+    umbra_status st = effective_tf(r, r->tf, &r->view_eff, r->view_eff_key);
+    if (st == UMBRA_SUCCESS)
+        st = effective_tf(r, r->light_tf ? r->light_tf : r->tf, &r->light_eff, r->light_eff_key);
+    return st;
+}
 
 float umbra__voxel_world(umbra_renderer r)
 {
@@ -672,7 +700,7 @@ static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     F->kd = o->kd;
     F->ks = o->ks;
     F->shininess = o->shininess;
-    F->tf_size = r->tf->count;
+    F->tf_size = umbra__view_tf(r)->count;
     uint32_t keep = F->flags & (UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
     F->flags = keep | (o->jitter ? UMBRA_FLAG_JITTER : 0u) | (o->shading ? UMBRA_FLAG_SHADING : 0u) |
                (o->ground_plane ? UMBRA_FLAG_GROUND : 0u) |
@@ -805,12 +833,14 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_context ctx = r->ctx;
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
+    if (st == UMBRA_SUCCESS)
+        st = effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
     st = prepare_shadow(r);
     if (st != UMBRA_SUCCESS)
         return st;
-    st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
+    st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
                 &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
@@ -844,7 +874,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     cl_mem preint = r->view_tf_buf;
     cl_uint preint_size = 0;
     if (r->shadow.preintegrated) {
-        st = umbra__preint_ensure(ctx, fn, &r->preint, r->tf, r->opts.step, UMBRA__PREINT_VIEW, 0,
+        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step, UMBRA__PREINT_VIEW, 0,
                                   &preint, NULL);
         if (st != UMBRA_SUCCESS)
             goto fail;
@@ -952,7 +982,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
                            fn, (const void *)points, (void *)rgb, count);
-    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS)
+    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS || (st = effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     if (!r->tech->kernel_file)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,

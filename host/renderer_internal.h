@@ -81,11 +81,19 @@ struct umbra_renderer_t {
     cl_program program;                      /* the ray caster + technique program in use */
     cl_kernel render_kernel, query_kernel;
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
+    /* The view and light transfer functions as the volume's normalised range sees them
+     * (umbra__tf_for_volume: the set ones, or resampled from their data range), and the
+     * (tf id, volume id) each was made for. Every technique reads these. */
+    umbra_transfer_function view_eff, light_eff;
+    uint64_t view_eff_key[2], light_eff_key[2];
 
     umbra_render_stats stats;
 };
 
-/* The light transfer function in effect (the view one unless a light one was set). */
+/* The view transfer function in effect, over the volume's normalised range (valid once a render
+ * or query has begun). */
+umbra_transfer_function umbra__view_tf(umbra_renderer r);
+/* The light transfer function in effect (the view one unless a light one was set), likewise. */
 umbra_transfer_function umbra__light_tf(umbra_renderer r);
 
 /* World units of one voxel step (the smallest spacing). */
