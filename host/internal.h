@@ -146,8 +146,8 @@ struct umbra_transfer_function_t {
 
 /* The table tf means for a volume whose normalised range [0,1] stands for data values
  * value_min..value_max: tf itself (retained) when it has no data range, else a new table over
- * [0,1] resampled from tf's range (values outside it take the end entries), fine enough that a
- * step of tf widens by at most a quarter of one of tf's entries (up to 65536 entries). */
+ * [0,1] resampled from tf's range (values outside it take the end entries), with 16 entries per
+ * entry of tf (up to 65536), so a jump of J between two of tf's entries is kept to within J/64. */
 umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
                                   umbra_transfer_function *out);
 

@@ -154,9 +154,11 @@ int umbra_transfer_function_get_range(umbra_transfer_function tf, float range[2]
 
 /* The most entries a resampled table gets, as many as a table may have. */
 #define TF_RESAMPLE_MAX 65536.0
-/* Resampled entries per source entry over the same data interval: a step between two source
- * entries then moves by at most a quarter of a source entry. */
-#define TF_RESAMPLE_FACTOR 4.0
+/* Resampled entries per source entry over the same data interval. Linear interpolation of the
+ * resampled table departs from tf's own (piecewise linear) function only next to tf's entries, by
+ * at most the slope change there times a quarter of the new spacing: for a jump of J between two
+ * neighbouring entries of tf, J / 64. */
+#define TF_RESAMPLE_FACTOR 16.0
 
 umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
                                   umbra_transfer_function *out)
