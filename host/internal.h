@@ -125,6 +125,10 @@ struct umbra_volume_t {
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre: (0.5 - dims/2) spacing */
 };
 
+/* Validates desc's index-to-world transform and sets v's (the identity map without one);
+ * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */
+umbra_status umbra__volume_set_transform(umbra_context ctx, const umbra_volume_desc *desc,
+                                         umbra_volume v);
 /* World -> local: l_a = axes_a . (w - origin) + centre0_a (points), axes_a . w (directions). */
 void umbra__volume_point_to_local(umbra_volume v, const float w[3], float out[3]);
 void umbra__volume_dir_to_local(umbra_volume v, const float w[3], float out[3]);

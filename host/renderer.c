@@ -419,39 +419,6 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
 
 /* ---- tables ---------------------------------------------------------------------------------------- */
 
-umbra_transfer_function umbra__view_tf(umbra_renderer r) { return r->view_eff; }
-umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_eff; }
-
-/* Keeps *eff equal to umbra__tf_for_volume(tf, volume), re-made when either changed. */
-static umbra_status effective_tf(umbra_renderer r, umbra_transfer_function tf,
-                                 umbra_transfer_function *eff, uint64_t key[2])
-{
-    const uint64_t want[2] = {tf->id, r->volume->id};
-    if (*eff && memcmp(want, key, sizeof want) == 0)
-        return UMBRA_SUCCESS;
-    umbra_transfer_function made = NULL;
-    umbra_status st = umbra__tf_for_volume(tf, r->volume->value_min, r->volume->value_max, &made);
-    if (st != UMBRA_SUCCESS)
-        return st;
-    umbra_transfer_function_release(*eff);
-    *eff = made;
-    memcpy(key, want, sizeof want);
-    return UMBRA_SUCCESS;
-}
-
-static umbra_status effective_tfs(umbra_renderer r)
-{
-    umbra_status st = effective_tf(r, r->tf, &r->view_eff, r->view_eff_key);
-    if (st == UMBRA_SUCCESS)
-        st = effective_tf(r, r->light_tf ? r->light_tf : r->tf, &r->light_eff, r->light_eff_key);
-    return st;
-}
-
-float umbra__voxel_world(umbra_renderer r)
-{
-    const float *s = r->volume->spacing;
-    return fminf(s[0], fminf(s[1], s[2]));
-}
 
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
  * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
@@ -619,35 +586,6 @@ void umbra__frame_update_light(umbra_renderer r)
     r->shadow_params.channels = r->channels;
 }
 
-/* The ground plane as (n, w), n.p + w = 0 in the local frame: horizontal (y up) in the world,
- * gap below the box's lowest world point. Without a transform that is n = (0, 1, 0) and
- * w = -y0, computed as it always was. */
-static void ground_plane(umbra_volume v, const float ext[3], float gap, float plane[4])
-{
-    if (!v->transformed) {
-        float y0 = -0.5f * ext[1] - gap;
-        set4(plane, 0.0f, 1.0f, 0.0f, -y0);
-        return;
-    }
-    double lowest = INFINITY;
-    for (int c = 0; c < 8; ++c) {
-        float corner[3];
-        double w[3];
-        for (int a = 0; a < 3; ++a)
-            corner[a] = ((c >> a) & 1 ? 0.5f : -0.5f) * ext[a];
-        umbra__volume_point_to_world(v, corner, w);
-        lowest = fmin(lowest, w[1]);
-    }
-    /* World plane y = y0; with w = origin + sum_a axes_a (l_a - centre0_a), its local normal is
-     * n_a = axes_a.y and n.l + (origin.y - y0 - n.centre0) = 0. */
-    double y0 = lowest - gap, off = v->origin[1] - y0;
-    for (int a = 0; a < 3; ++a) {
-        plane[a] = (float)v->axes[3 * a + 1];
-        off -= v->axes[3 * a + 1] * v->centre0[a];
-    }
-    plane[3] = (float)off;
-}
-
 static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
 {
     UmbraFrame *F = &r->frame;
@@ -691,7 +629,7 @@ static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     set4(F->ambient, o->ambient[0], o->ambient[1], o->ambient[2], 0.0f);
     set4(F->background, o->background[0], o->background[1], o->background[2], o->background[3]);
     set4(F->ground_color, o->ground_color[0], o->ground_color[1], o->ground_color[2], 0.0f);
-    ground_plane(v, ext, o->ground_offset * diag, F->ground);
+    umbra__ground_plane(v, ext, o->ground_offset * diag, F->ground);
     F->width = width;
     F->height = height;
     F->seed = o->seed;
@@ -834,7 +772,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
     if (st == UMBRA_SUCCESS)
-        st = effective_tfs(r);
+        st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
     st = prepare_shadow(r);
@@ -982,7 +920,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
                            fn, (const void *)points, (void *)rgb, count);
-    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS || (st = effective_tfs(r)) != UMBRA_SUCCESS)
+    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS || (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     if (!r->tech->kernel_file)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,

@@ -96,6 +96,14 @@ umbra_transfer_function umbra__view_tf(umbra_renderer r);
 /* The light transfer function in effect (the view one unless a light one was set), likewise. */
 umbra_transfer_function umbra__light_tf(umbra_renderer r);
 
+/* Brings r->view_eff and r->light_eff up to date with the transfer functions and volume set
+ * (host/world.c). */
+umbra_status umbra__effective_tfs(umbra_renderer r);
+
+/* The ground plane (n.p + w = 0 in v's local frame) horizontal in v's world, gap world units below
+ * the box's lowest corner; ext is the box size. */
+void umbra__ground_plane(umbra_volume v, const float ext[3], float gap, float plane[4]);
+
 /* World units of one voxel step (the smallest spacing). */
 float umbra__voxel_world(umbra_renderer r);
 

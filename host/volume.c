@@ -81,115 +81,6 @@ static umbra_status validate(umbra_context ctx, const umbra_volume_desc *d)
     return UMBRA_SUCCESS;
 }
 
-static double dot3d(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-/* Largest |cos| between two index axes accepted as a right angle: 1e-3 is 0.057 degrees, what a
- * header printed with 6 digits (or float rounding) leaves; a gantry tilt is degrees. */
-#define AXIS_COS_TOLERANCE 1e-3
-
-/* The transform of desc (validated) into v: unit axes, checked for right angles and snapped to an
- * exactly orthonormal set (Gram-Schmidt, keeping axis 0 and the handedness), so the world ->
- * local map is exactly its inverse's transpose and preserves distances. */
-static umbra_status set_transform(umbra_context ctx, const umbra_volume_desc *d, umbra_volume v)
-{
-    const char *fn = "umbra_volume_create";
-    double ax[3][3];
-    for (int a = 0; a < 3; ++a)
-        v->centre0[a] = (0.5 - 0.5 * (double)d->dims[a]) * (double)d->spacing[a];
-    if (!d->transform_given) {
-        for (int a = 0; a < 3; ++a) {
-            v->origin[a] = v->centre0[a];
-            for (int k = 0; k < 3; ++k)
-                v->axes[3 * a + k] = a == k ? 1.0 : 0.0;
-        }
-        return UMBRA_SUCCESS;
-    }
-    for (int a = 0; a < 3; ++a) {
-        if (!isfinite(d->origin[a]))
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: origin (%g, %g, %g) must be finite", fn, d->origin[0],
-                               d->origin[1], d->origin[2]);
-        for (int k = 0; k < 3; ++k)
-            ax[a][k] = d->directions[3 * a + k];
-        double len = sqrt(dot3d(ax[a], ax[a]));
-        if (!(len > 0.0) || !isfinite(len))
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: direction of index axis %d (%g, %g, %g) must be finite and "
-                               "non-zero", fn, a, ax[a][0], ax[a][1], ax[a][2]);
-        for (int k = 0; k < 3; ++k)
-            ax[a][k] /= len;
-    }
-    for (int a = 0; a < 3; ++a)
-        for (int b = a + 1; b < 3; ++b) {
-            double c = dot3d(ax[a], ax[b]);
-            if (fabs(c) > AXIS_COS_TOLERANCE)
-                return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                                   "%s: index axes %d and %d meet at %.3f degrees; only "
-                                   "orthogonal grids are supported (at most %.3f degrees off a "
-                                   "right angle), not sheared ones (such as a CT gantry tilt): "
-                                   "resample the volume first", fn, a, b,
-                                   acos(fmax(-1.0, fmin(1.0, c))) * 57.29577951308232,
-                                   asin(AXIS_COS_TOLERANCE) * 57.29577951308232);
-        }
-    /* Handedness of the given axes, kept by the snapped third axis. */
-    double cr[3] = {ax[0][1] * ax[1][2] - ax[0][2] * ax[1][1], ax[0][2] * ax[1][0] - ax[0][0] * ax[1][2],
-                    ax[0][0] * ax[1][1] - ax[0][1] * ax[1][0]};
-    double hand = dot3d(cr, ax[2]) < 0.0 ? -1.0 : 1.0;
-    double c01 = dot3d(ax[0], ax[1]);
-    for (int k = 0; k < 3; ++k)
-        ax[1][k] -= c01 * ax[0][k];
-    double l1 = sqrt(dot3d(ax[1], ax[1]));
-    for (int k = 0; k < 3; ++k)
-        ax[1][k] /= l1;
-    ax[2][0] = hand * (ax[0][1] * ax[1][2] - ax[0][2] * ax[1][1]);
-    ax[2][1] = hand * (ax[0][2] * ax[1][0] - ax[0][0] * ax[1][2]);
-    ax[2][2] = hand * (ax[0][0] * ax[1][1] - ax[0][1] * ax[1][0]);
-    v->transformed = 1;
-    for (int a = 0; a < 3; ++a) {
-        v->origin[a] = d->origin[a];
-        for (int k = 0; k < 3; ++k)
-            v->axes[3 * a + k] = ax[a][k];
-    }
-    return UMBRA_SUCCESS;
-}
-
-void umbra__volume_point_to_local(umbra_volume v, const float w[3], float out[3])
-{
-    if (!v->transformed) {
-        memcpy(out, w, 3 * sizeof *out);
-        return;
-    }
-    double q[3] = {(double)w[0] - v->origin[0], (double)w[1] - v->origin[1],
-                   (double)w[2] - v->origin[2]};
-    for (int a = 0; a < 3; ++a)
-        out[a] = (float)(dot3d(v->axes + 3 * a, q) + v->centre0[a]);
-}
-
-void umbra__volume_dir_to_local(umbra_volume v, const float w[3], float out[3])
-{
-    if (!v->transformed) {
-        memcpy(out, w, 3 * sizeof *out);
-        return;
-    }
-    double q[3] = {w[0], w[1], w[2]};
-    for (int a = 0; a < 3; ++a)
-        out[a] = (float)dot3d(v->axes + 3 * a, q);
-}
-
-void umbra__volume_point_to_world(umbra_volume v, const float l[3], double out[3])
-{
-    if (!v->transformed) {
-        for (int k = 0; k < 3; ++k)
-            out[k] = l[k];
-        return;
-    }
-    for (int k = 0; k < 3; ++k) {
-        out[k] = v->origin[k];
-        for (int a = 0; a < 3; ++a)
-            out[k] += v->axes[3 * a + k] * ((double)l[a] - v->centre0[a]);
-    }
-}
-
 /* Min/max over each brick's footprint: voxels [b*B, (b+1)*B] per axis, clamped to the grid. */
 static void compute_bricks(umbra_volume v, const float *vox)
 {
@@ -276,7 +167,7 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     umbra_context_retain(ctx);
     memcpy(v->dims, desc->dims, sizeof v->dims);
     memcpy(v->spacing, desc->spacing, sizeof v->spacing);
-    if ((st = set_transform(ctx, desc, v)) != UMBRA_SUCCESS)
+    if ((st = umbra__volume_set_transform(ctx, desc, v)) != UMBRA_SUCCESS)
         goto fail;
     v->brick_size = desc->brick_size;
     for (int a = 0; a < 3; ++a)
