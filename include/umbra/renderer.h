@@ -3,9 +3,9 @@
  * A renderer draws one volume with a view transfer function from a camera, lit by one light, and
  * takes a per-sample RGB shadow factor from the selected shadow technique. Camera, light, ground
  * plane and query points are in the volume's world (volume.h: the centred box unless the volume
- * carries an index-to-world transform). Setters copy their
- * arguments and mark what changed; render() rebuilds only what the change calls for (moving the
- * camera re-uses a shadow map built for the same light, volume and light transfer function).
+ * carries an index-to-world transform). Setters copy their arguments and mark what changed;
+ * render() rebuilds only what the change calls for (moving the camera re-uses a shadow map built
+ * for the same light, volume and light transfer function).
  *
  * Shading model, shared by every technique. A sample of (step-corrected) opacity a and
  * transmission colour t passes the fraction 1 - a (1 - t_c) of light channel c (the CSSM paper's

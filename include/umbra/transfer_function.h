@@ -5,8 +5,8 @@
  * (umbra_transfer_function_set_range, or "range LO HI" in a file) the entries span data values
  * LO..HI instead, in the volume's own units (e.g. Hounsfield units), whatever the volume's value
  * range: the renderer resamples the table onto each volume's range, and data values outside
- * LO..HI take the end entries. Alpha is the opacity of one
- * sample taken every voxel (the reference step); renderers correct it for their own step with
+ * LO..HI take the end entries. Alpha is the opacity of one sample taken every voxel (the
+ * reference step); renderers correct it for their own step with
  * a' = 1 - (1 - a)^(step / reference_step). RGB is the emitted colour for the view, and for a light
  * transfer function in UMBRA_TRANSMISSION_COLORED mode the transmission colour t of the shading
  * model (see renderer.h). */
