@@ -122,7 +122,7 @@ struct umbra_volume_t {
     int transformed;
     double origin[3];        /* world position of voxel (0, 0, 0)'s centre */
     double axes[9];          /* orthonormal world direction of index axis a in axes[3a..3a+2] */
-    double centre0[3];       /* local position of voxel (0, 0, 0)'s centre: (0.5 - dims/2) spacing */
+    double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);

@@ -419,6 +419,11 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
 
 /* ---- tables ---------------------------------------------------------------------------------------- */
 
+float umbra__voxel_world(umbra_renderer r)
+{
+    const float *s = r->volume->spacing;
+    return fminf(s[0], fminf(s[1], s[2]));
+}
 
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
  * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
@@ -778,8 +783,8 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     st = prepare_shadow(r);
     if (st != UMBRA_SUCCESS)
         return st;
-    st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
-                &r->view_cells_buf);
+    st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
+                &r->view_bricks_buf, &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
     frame_update_view(r, width, height);
@@ -812,8 +817,8 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     cl_mem preint = r->view_tf_buf;
     cl_uint preint_size = 0;
     if (r->shadow.preintegrated) {
-        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step, UMBRA__PREINT_VIEW, 0,
-                                  &preint, NULL);
+        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step,
+                                  UMBRA__PREINT_VIEW, 0, &preint, NULL);
         if (st != UMBRA_SUCCESS)
             goto fail;
         preint_size = UMBRA__PREINT_SIZE;
@@ -920,7 +925,8 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
                            fn, (const void *)points, (void *)rgb, count);
-    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS || (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
+    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS ||
+        (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     if (!r->tech->kernel_file)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,

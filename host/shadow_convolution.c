@@ -319,8 +319,9 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         float len = conv_light_step(&r->shadow);
         int colored = r->opts.transmission == UMBRA_TRANSMISSION_COLORED;
         double before = r->stats.shadow_build_ms;
-        if ((st = umbra__preint_ensure(ctx, fn, &s->pi_view, umbra__view_tf(r), len, UMBRA__PREINT_VIEW, 0,
-                                       &pi_view, &r->stats.shadow_build_ms)) ||
+        if ((st = umbra__preint_ensure(ctx, fn, &s->pi_view, umbra__view_tf(r), len,
+                                       UMBRA__PREINT_VIEW, 0, &pi_view,
+                                       &r->stats.shadow_build_ms)) ||
             (st = umbra__preint_ensure(ctx, fn, &s->pi_light, umbra__light_tf(r), len,
                                        UMBRA__PREINT_LIGHT, colored, &pi_light,
                                        &r->stats.shadow_build_ms)))

@@ -15,7 +15,10 @@
 
 #include "renderer_internal.h"
 
-static double dot3d(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dot3d(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 
 /* Largest |cos| between two index axes accepted as a right angle: 1e-3 is 0.057 degrees, what a
  * header printed with 6 digits (or float rounding) leaves; a gantry tilt is degrees. */
@@ -67,7 +70,8 @@ umbra_status umbra__volume_set_transform(umbra_context ctx, const umbra_volume_d
                                    asin(AXIS_COS_TOLERANCE) * 57.29577951308232);
         }
     /* Handedness of the given axes, kept by the snapped third axis. */
-    double cr[3] = {ax[0][1] * ax[1][2] - ax[0][2] * ax[1][1], ax[0][2] * ax[1][0] - ax[0][0] * ax[1][2],
+    double cr[3] = {ax[0][1] * ax[1][2] - ax[0][2] * ax[1][1],
+                    ax[0][2] * ax[1][0] - ax[0][0] * ax[1][2],
                     ax[0][0] * ax[1][1] - ax[0][1] * ax[1][0]};
     double hand = dot3d(cr, ax[2]) < 0.0 ? -1.0 : 1.0;
     double c01 = dot3d(ax[0], ax[1]);
@@ -183,10 +187,4 @@ umbra_status umbra__effective_tfs(umbra_renderer r)
     if (st == UMBRA_SUCCESS)
         st = effective_tf(r, r->light_tf ? r->light_tf : r->tf, &r->light_eff, r->light_eff_key);
     return st;
-}
-
-float umbra__voxel_world(umbra_renderer r)
-{
-    const float *s = r->volume->spacing;
-    return fminf(s[0], fminf(s[1], s[2]));
 }
