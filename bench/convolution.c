@@ -425,8 +425,10 @@ int bench_convolution(int argc, char **argv)
                      0.5f * info.extent[1];
         memset(&cam, 0, sizeof cam);
         cam.projection = UMBRA_PERSPECTIVE;
-        for (int a = 0; a < 3; ++a)
-            cam.eye[a] = dir[a] / len * dist;
+        for (int a = 0; a < 3; ++a) { /* around the box's world centre (0 unless transformed) */
+            cam.eye[a] = info.center[a] + dir[a] / len * dist;
+            cam.target[a] = info.center[a];
+        }
         cam.up[0] = 1.0f;
         cam.fovy_degrees = 30.0f;
         light.direction[0] = -0.7f;

@@ -576,6 +576,14 @@ umbra_status scene_create(umbra_context ctx, const scene_spec *s, umbra_scene *s
         if (s->have_light_color)
             l->color[i] = s->light_color[i];
     }
+    /* Scene coordinates are relative to the box's centre; a volume with an index-to-world
+     * transform (a NRRD's space origin) has its centre elsewhere in its world. */
+    for (int i = 0; i < 3; ++i) {
+        c->eye[i] += info.center[i];
+        c->target[i] += info.center[i];
+        if (l->type == UMBRA_LIGHT_POINT)
+            l->position[i] += info.center[i];
+    }
     umbra_render_desc *o = &scene->options;
     if (s->step > 0.0f)
         o->step = s->step;

@@ -14,7 +14,8 @@
  *   light_tf FILE               optional separate transfer function for the light pass
  *   description TEXT...         one line for the summary
  *   units diagonal | world      unit of eye, target, ortho_height and light_position: multiples
- *                               of the volume box's diagonal (default) or world units
+ *                               of the volume box's diagonal (default) or world units; eye,
+ *                               target and light_position are relative to the box's centre
  *   camera perspective | orthographic
  *   eye X Y Z / target X Y Z / up X Y Z / fov DEG / ortho_height H
  *   light point | directional

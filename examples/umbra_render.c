@@ -20,15 +20,19 @@ static void usage(FILE *f)
         "  --raw FILE --raw-dims XxYxZ --raw-type uint8|uint16|int16|float32 [--raw-big-endian]\n"
         "  --tf FILE             transfer function (text format, see README)\n"
         "  --light-tf FILE       separate transfer function for the light pass\n"
+        "  --tf-range LO,HI      the transfer functions span data values LO..HI (overrides a\n"
+        "                        file's range line: an HU preset on data stored as HU + 1024\n"
+        "                        takes --tf-range 0,4095)\n"
         "  --size WxH            image size (default 512x512)\n"
         "  --out FILE            output image, .png or .exr (default umbra.png)\n"
         "  --technique NAME      none | reference | threshold | deep | cssm | convolution\n"
-        "  --camera-dir X,Y,Z    orbit camera from this direction\n"
-        "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z   look-at camera\n"
+        "  --camera-dir X,Y,Z    orbit camera around the box's centre from this direction\n"
+        "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z   look-at camera, in the volume's world\n"
+        "                        (a NRRD's space; else the box is centred at 0)\n"
         "  --fov DEG             vertical field of view (default 30)\n"
         "  --ortho H             orthographic camera of view height H\n"
         "  --light-dir X,Y,Z     directional light travelling along X,Y,Z\n"
-        "  --light-pos X,Y,Z     point light at X,Y,Z (world units, volume centred at 0)\n"
+        "  --light-pos X,Y,Z     point light at X,Y,Z (the volume's world)\n"
         "  --light-color R,G,B   light colour (default 1,1,1)\n"
         "  --ambient A           ambient light (default 0.2)\n"
         "  --step S              view sampling step in voxels (default 0.5)\n"
@@ -107,6 +111,8 @@ typedef struct options {
     int have_camera_dir, have_eye, have_target, have_up;
     float light_dir[3], light_pos[3], light_color[3], ambient, step, background[4];
     int have_light_dir, have_light_pos, have_light_color, have_ambient, have_step;
+    float tf_range[2];
+    int have_tf_range;
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
     uint32_t seed;
     umbra_shadow_desc shadow;
@@ -164,6 +170,7 @@ static int parse_args(int argc, char **argv, options *o)
         } else if (FLAG("--raw-big-endian")) o->raw_desc.big_endian = 1;
         else if (FLAG("--tf")) { NEED(); o->tf = v; }
         else if (FLAG("--light-tf")) { NEED(); o->light_tf = v; }
+        else if (FLAG("--tf-range")) { NEED(); if (!parse_floats(v, o->tf_range, 2)) BAD("--tf-range '%s' is not LO,HI", v); o->have_tf_range = 1; }
         else if (FLAG("--size")) { NEED(); if (!parse_size(v, &o->width, &o->height)) BAD("--size '%s' is not WxH with sides in [1, 16384]", v); }
         else if (FLAG("--out")) { NEED(); o->out = v; }
         else if (FLAG("--technique")) {
@@ -267,7 +274,8 @@ static int run(const options *o, session *s)
         float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
                            info.extent[2] * info.extent[2]);
         const float dir[3] = {0.75f, 0.5f, 1.0f};
-        cam = umbra_camera_orbit(dir, diag, o->fov);
+        /* Around the box's world centre: a NRRD with a space origin is not centred on 0. */
+        cam = umbra_camera_orbit_at(info.center, dir, diag, o->fov);
         memset(&light, 0, sizeof light);
         light.type = UMBRA_LIGHT_DIRECTIONAL;
         light.direction[0] = 0.45f;
@@ -300,13 +308,19 @@ static int run(const options *o, session *s)
     }
     if (o->light_tf && umbra_transfer_function_load(s->ctx, o->light_tf, &s->light_tf) != UMBRA_SUCCESS)
         return 1;
+    /* The library checks LO < HI and names the values. */
+    if (o->have_tf_range &&
+        (umbra_transfer_function_set_range(tf, o->tf_range[0], o->tf_range[1]) != UMBRA_SUCCESS ||
+         (s->light_tf &&
+          umbra_transfer_function_set_range(s->light_tf, o->tf_range[0], o->tf_range[1]) != UMBRA_SUCCESS)))
+        return 1;
 
     if (o->have_camera_dir) {
         umbra_volume_info info;
         umbra_volume_get_info(vol, &info);
         float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
                            info.extent[2] * info.extent[2]);
-        cam = umbra_camera_orbit(o->camera_dir, diag * 1.1f, o->fov);
+        cam = umbra_camera_orbit_at(info.center, o->camera_dir, diag * 1.1f, o->fov);
     }
     if (o->have_eye) memcpy(cam.eye, o->eye, sizeof cam.eye);
     if (o->have_target) memcpy(cam.target, o->target, sizeof cam.target);

@@ -120,7 +120,24 @@ struct umbra_volume_t {
     cl_mem image;            /* CL_R / CL_FLOAT 3D image (image sampler), or NULL */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
+    /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
+     * box); the host maps world inputs into it. Without a transform (transformed 0) world and
+     * local coincide and the maps copy their input, so default scenes stay bit for bit. */
+    int transformed;
+    double origin[3];        /* world position of voxel (0, 0, 0)'s centre */
+    double axes[9];          /* orthonormal world direction of index axis a in axes[3a..3a+2] */
+    double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
+
+/* Validates desc's index-to-world transform and sets v's (the identity map without one);
+ * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */
+umbra_status umbra__volume_set_transform(umbra_context ctx, const umbra_volume_desc *desc,
+                                         umbra_volume v);
+/* World -> local: l_a = axes_a . (w - origin) + centre0_a (points), axes_a . w (directions). */
+void umbra__volume_point_to_local(umbra_volume v, const float w[3], float out[3]);
+void umbra__volume_dir_to_local(umbra_volume v, const float w[3], float out[3]);
+/* Local -> world: origin + sum_a axes_a (l_a - centre0_a). */
+void umbra__volume_point_to_world(umbra_volume v, const float l[3], double out[3]);
 
 /* ---- transfer function ---------------------------------------------------------------------- */
 
@@ -130,8 +147,17 @@ struct umbra_transfer_function_t {
     uint32_t count;
     float *rgba;             /* host copy, 4*count */
     cl_mem buffer;           /* device copy, float4 per entry */
-    uint64_t id;             /* unique per table */
+    uint64_t id;             /* unique per table (and per range: set_range gives a new id) */
+    int range_given;         /* nonzero: the table spans data values range_lo..range_hi */
+    float range_lo, range_hi;
 };
+
+/* The table tf means for a volume whose normalised range [0,1] stands for data values
+ * value_min..value_max: tf itself (retained) when it has no data range, else a new table over
+ * [0,1] resampled from tf's range (values outside it take the end entries), with 16 entries per
+ * entry of tf (up to 65536), so a jump of J between two of tf's entries is kept to within J/64. */
+umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
+                                  umbra_transfer_function *out);
 
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);

@@ -47,8 +47,9 @@ void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
     S->map_size = map_size;
     memset(S->ls_origin, 0, sizeof S->ls_origin);
 
-    if (r->light.type == UMBRA_LIGHT_DIRECTIONAL) {
-        basis_from(r->light.direction, u, v, w);
+    /* F->light is the light in the volume's local frame (the box is centred there). */
+    if (!(F->flags & UMBRA_FLAG_POINT_LIGHT)) {
+        basis_from(F->light, u, v, w);
         for (int c = 0; c < 8; ++c) {
             float p[3] = {dot3(corners[c], u), dot3(corners[c], v), dot3(corners[c], w)};
             for (int a = 0; a < 3; ++a) {
@@ -58,7 +59,7 @@ void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
         }
         S->ls_mode = UMBRA_LS_ORTHO;
     } else {
-        const float *P = r->light.position;
+        const float *P = F->light;
         float centre[3] = {-P[0], -P[1], -P[2]}; /* the box is centred on the origin */
         float dist_centre = sqrtf(dot3(centre, centre));
         /* Nearest box point: distance 0 inside; farthest: the farthest corner. */

@@ -117,6 +117,13 @@ static void cross3(const float a[3], const float b[3], float out[3])
 
 umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees)
 {
+    const float origin[3] = {0.0f, 0.0f, 0.0f};
+    return umbra_camera_orbit_at(origin, dir, box_diagonal, fovy_degrees);
+}
+
+umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], float box_diagonal,
+                                   float fovy_degrees)
+{
     umbra_camera c;
     memset(&c, 0, sizeof c);
     float d[3] = {dir[0], dir[1], dir[2]};
@@ -125,8 +132,10 @@ umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fo
         fovy_degrees = 30.0f;
     float dist = 0.5f * box_diagonal / sinf(0.5f * fovy_degrees * 3.14159265f / 180.0f) * 1.05f;
     c.projection = UMBRA_PERSPECTIVE;
-    for (int i = 0; i < 3; ++i)
-        c.eye[i] = d[i] * dist;
+    for (int i = 0; i < 3; ++i) {
+        c.eye[i] = center[i] + d[i] * dist;
+        c.target[i] = center[i];
+    }
     c.up[1] = 1.0f;
     if (fabsf(d[1]) > 0.99f) { /* looking straight down or up: y cannot be "up" */
         c.up[1] = 0.0f;
@@ -210,6 +219,8 @@ void umbra_renderer_release(umbra_renderer r)
     umbra_volume_release(r->volume);
     umbra_transfer_function_release(r->tf);
     umbra_transfer_function_release(r->light_tf);
+    umbra_transfer_function_release(r->view_eff);
+    umbra_transfer_function_release(r->light_eff);
     umbra_context_release(r->ctx);
     free(r);
 }
@@ -408,8 +419,6 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
 
 /* ---- tables ---------------------------------------------------------------------------------------- */
 
-umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_tf ? r->light_tf : r->tf; }
-
 float umbra__voxel_world(umbra_renderer r)
 {
     const float *s = r->volume->spacing;
@@ -555,11 +564,16 @@ void umbra__frame_update_light(umbra_renderer r)
     }
     F->dims[3] = 0;
     F->bricks[3] = (int32_t)v->brick_size;
+    /* The light is given in the volume's world; the kernels work in its local frame. */
     const umbra_light *l = &r->light;
-    if (l->type == UMBRA_LIGHT_POINT)
-        set4(F->light, l->position[0], l->position[1], l->position[2], 1.0f);
-    else
-        set4(F->light, l->direction[0], l->direction[1], l->direction[2], 0.0f);
+    float lp[3];
+    if (l->type == UMBRA_LIGHT_POINT) {
+        umbra__volume_point_to_local(v, l->position, lp);
+        set4(F->light, lp[0], lp[1], lp[2], 1.0f);
+    } else {
+        umbra__volume_dir_to_local(v, l->direction, lp);
+        set4(F->light, lp[0], lp[1], lp[2], 0.0f);
+    }
     set4(F->light_color, l->color[0], l->color[1], l->color[2], 0.0f);
     F->flags &= ~(UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
     if (l->type == UMBRA_LIGHT_POINT)
@@ -587,31 +601,40 @@ static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
         diag += ext[a] * ext[a];
     }
     diag = sqrtf(diag);
+    umbra_volume v = r->volume;
     umbra_camera c = r->camera;
     if (!r->camera_set) {
-        const float dir[3] = {0.6f, 0.45f, 1.0f};
-        c = umbra_camera_orbit(dir, diag, 30.0f);
+        const float dir[3] = {0.6f, 0.45f, 1.0f}, zero[3] = {0.0f, 0.0f, 0.0f};
+        double centre[3];
+        umbra__volume_point_to_world(v, zero, centre);
+        const float at[3] = {(float)centre[0], (float)centre[1], (float)centre[2]};
+        c = umbra_camera_orbit_at(at, dir, diag, 30.0f);
     }
-    float f[3] = {c.target[0] - c.eye[0], c.target[1] - c.eye[1], c.target[2] - c.eye[2]};
-    normalize3(f);
-    float right[3], up[3];
-    cross3(f, c.up, right);
-    normalize3(right);
-    cross3(right, f, up);
+    /* The camera's frame is built in the world (so a mirrored volume does not mirror the
+     * image) and then taken into the volume's local frame, vector by vector. */
+    float fw[3] = {c.target[0] - c.eye[0], c.target[1] - c.eye[1], c.target[2] - c.eye[2]};
+    normalize3(fw);
+    float rw[3], uw[3], f[3], right[3], up[3], eye[3];
+    cross3(fw, c.up, rw);
+    normalize3(rw);
+    cross3(rw, fw, uw);
+    umbra__volume_dir_to_local(v, fw, f);
+    umbra__volume_dir_to_local(v, rw, right);
+    umbra__volume_dir_to_local(v, uw, up);
+    umbra__volume_point_to_local(v, c.eye, eye);
     float aspect = (float)width / (float)height;
     float half_h = c.projection == UMBRA_ORTHOGRAPHIC
                        ? 0.5f * c.ortho_height
                        : tanf(0.5f * c.fovy_degrees * 3.14159265358979f / 180.0f);
     float half_w = half_h * aspect;
-    set4(F->eye, c.eye[0], c.eye[1], c.eye[2], 0.0f);
+    set4(F->eye, eye[0], eye[1], eye[2], 0.0f);
     set4(F->right, right[0] * half_w, right[1] * half_w, right[2] * half_w, 0.0f);
     set4(F->up, up[0] * half_h, up[1] * half_h, up[2] * half_h, 0.0f);
     set4(F->forward, f[0], f[1], f[2], 0.0f);
     set4(F->ambient, o->ambient[0], o->ambient[1], o->ambient[2], 0.0f);
     set4(F->background, o->background[0], o->background[1], o->background[2], o->background[3]);
     set4(F->ground_color, o->ground_color[0], o->ground_color[1], o->ground_color[2], 0.0f);
-    float y0 = -0.5f * ext[1] - o->ground_offset * diag;
-    set4(F->ground, 0.0f, 1.0f, 0.0f, -y0);
+    umbra__ground_plane(v, ext, o->ground_offset * diag, F->ground);
     F->width = width;
     F->height = height;
     F->seed = o->seed;
@@ -620,7 +643,7 @@ static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     F->kd = o->kd;
     F->ks = o->ks;
     F->shininess = o->shininess;
-    F->tf_size = r->tf->count;
+    F->tf_size = umbra__view_tf(r)->count;
     uint32_t keep = F->flags & (UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
     F->flags = keep | (o->jitter ? UMBRA_FLAG_JITTER : 0u) | (o->shading ? UMBRA_FLAG_SHADING : 0u) |
                (o->ground_plane ? UMBRA_FLAG_GROUND : 0u) |
@@ -779,13 +802,15 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_context ctx = r->ctx;
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
+    if (st == UMBRA_SUCCESS)
+        st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
     st = prepare_shadow(r);
     if (st != UMBRA_SUCCESS)
         return st;
-    st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
-                &r->view_cells_buf);
+    st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
+                &r->view_bricks_buf, &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
     frame_update_view(r, width, height);
@@ -817,8 +842,8 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     cl_mem preint = r->view_tf_buf;
     cl_uint preint_size = 0;
     if (r->shadow.preintegrated) {
-        st = umbra__preint_ensure(ctx, fn, &r->preint, r->tf, r->opts.step, UMBRA__PREINT_VIEW, 0,
-                                  &preint, NULL);
+        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step,
+                                  UMBRA__PREINT_VIEW, 0, &preint, NULL);
         if (st != UMBRA_SUCCESS)
             goto fail;
         preint_size = UMBRA__PREINT_SIZE;
@@ -1026,11 +1051,13 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     cl_mem in = NULL, outb = NULL;
+    float *moved = NULL;
     if (!points || !rgb || count == 0 || count > (1u << 28))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
                            fn, (const void *)points, (void *)rgb, count);
-    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS)
+    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS ||
+        (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     if (!r->tech->kernel_file)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
@@ -1040,9 +1067,19 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return st;
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
         return st;
+    /* The points are in the volume's world; the kernel takes them in its local frame. */
+    const float *local = points;
+    if (r->volume->transformed) {
+        if (!(moved = malloc(count * 3 * sizeof *moved)))
+            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                               "%s: out of host memory for %zu points", fn, count);
+        for (size_t i = 0; i < count; ++i)
+            umbra__volume_point_to_local(r->volume, points + 3 * i, moved + 3 * i);
+        local = moved;
+    }
     cl_int err;
     in = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, count * 12,
-                        (void *)points, &err);
+                        (void *)local, &err);
     UMBRA_CL_CHECK(err, "clCreateBuffer(points)");
     outb = clCreateBuffer(ctx->cl_ctx, CL_MEM_WRITE_ONLY, count * 12, NULL, &err);
     UMBRA_CL_CHECK(err, "clCreateBuffer(rgb)");
@@ -1061,6 +1098,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         goto fail;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
 fail:
+    free(moved);
     release_mem(&in);
     release_mem(&outb);
     return st;

@@ -89,13 +89,29 @@ struct umbra_renderer_t {
     cl_program program;                      /* the ray caster + technique program in use */
     cl_kernel render_kernel, query_kernel;
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
+    /* The view and light transfer functions as the volume's normalised range sees them
+     * (umbra__tf_for_volume: the set ones, or resampled from their data range), and the
+     * (tf id, volume id) each was made for. Every technique reads these. */
+    umbra_transfer_function view_eff, light_eff;
+    uint64_t view_eff_key[2], light_eff_key[2];
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
 };
 
-/* The light transfer function in effect (the view one unless a light one was set). */
+/* The view transfer function in effect, over the volume's normalised range (valid once a render
+ * or query has begun). */
+umbra_transfer_function umbra__view_tf(umbra_renderer r);
+/* The light transfer function in effect (the view one unless a light one was set), likewise. */
 umbra_transfer_function umbra__light_tf(umbra_renderer r);
+
+/* Brings r->view_eff and r->light_eff up to date with the transfer functions and volume set
+ * (host/world.c). */
+umbra_status umbra__effective_tfs(umbra_renderer r);
+
+/* The ground plane (n.p + w = 0 in v's local frame) horizontal in v's world, gap world units below
+ * the box's lowest corner; ext is the box size. */
+void umbra__ground_plane(umbra_volume v, const float ext[3], float gap, float plane[4]);
 
 /* World units of one voxel step (the smallest spacing). */
 float umbra__voxel_world(umbra_renderer r);

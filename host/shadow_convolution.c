@@ -171,16 +171,17 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
      * the ground plane (found by casting the box's corners onto it), at most 2 diagonals on. */
     float z_end = zmax;
     if (F->flags & UMBRA_FLAG_GROUND) {
-        const float y0 = -F->ground[3];
+        /* The plane n.p + w = 0 (local frame; n = (0, 1, 0) unless the volume is rotated). */
         for (int c = 0; c < 8; ++c) {
             float o[3], d[3];
             for (int a = 0; a < 3; ++a) {
                 o[a] = point ? F->light[a] : corners[c][a];
                 d[a] = point ? corners[c][a] - F->light[a] : F->light[a];
             }
-            if (!(d[1] < 0.0f) || !(o[1] > y0))
+            const float dn = dot3(F->ground, d), height = dot3(F->ground, o) + F->ground[3];
+            if (!(dn < 0.0f) || !(height > 0.0f))
                 continue;
-            float t = (y0 - o[1]) / d[1], g[3], v[3];
+            float t = -height / dn, g[3], v[3];
             for (int a = 0; a < 3; ++a) {
                 g[a] = o[a] + t * d[a];
                 v[a] = g[a] - eye[a];
@@ -318,8 +319,9 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         float len = conv_light_step(&r->shadow);
         int colored = r->opts.transmission == UMBRA_TRANSMISSION_COLORED;
         double before = r->stats.shadow_build_ms;
-        if ((st = umbra__preint_ensure(ctx, fn, &s->pi_view, r->tf, len, UMBRA__PREINT_VIEW, 0,
-                                       &pi_view, &r->stats.shadow_build_ms)) ||
+        if ((st = umbra__preint_ensure(ctx, fn, &s->pi_view, umbra__view_tf(r), len,
+                                       UMBRA__PREINT_VIEW, 0, &pi_view,
+                                       &r->stats.shadow_build_ms)) ||
             (st = umbra__preint_ensure(ctx, fn, &s->pi_light, umbra__light_tf(r), len,
                                        UMBRA__PREINT_LIGHT, colored, &pi_light,
                                        &r->stats.shadow_build_ms)))

@@ -126,6 +126,73 @@ umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
     return tf_make(ctx, fn, table, resolution, out);
 }
 
+umbra_status umbra_transfer_function_set_range(umbra_transfer_function tf, float lo, float hi)
+{
+    const char *fn = "umbra_transfer_function_set_range";
+    if (!tf)
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    if (!isfinite(lo) || !isfinite(hi) || !(hi > lo))
+        return umbra__fail(tf->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: range [%g, %g] must be finite with hi > lo", fn, lo, hi);
+    tf->range_given = 1;
+    tf->range_lo = lo;
+    tf->range_hi = hi;
+    tf->id = umbra__next_id(tf->ctx); /* renderers re-derive their tables from it */
+    return UMBRA_SUCCESS;
+}
+
+int umbra_transfer_function_get_range(umbra_transfer_function tf, float range[2])
+{
+    if (!tf || !tf->range_given)
+        return 0;
+    if (range) {
+        range[0] = tf->range_lo;
+        range[1] = tf->range_hi;
+    }
+    return 1;
+}
+
+/* The most entries a resampled table gets, as many as a table may have. */
+#define TF_RESAMPLE_MAX 65536.0
+/* Resampled entries per source entry over the same data interval. Linear interpolation of the
+ * resampled table departs from tf's own (piecewise linear) function only next to tf's entries, by
+ * at most the slope change there times a quarter of the new spacing: for a jump of J between two
+ * neighbouring entries of tf, J / 64. */
+#define TF_RESAMPLE_FACTOR 16.0
+
+umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
+                                  umbra_transfer_function *out)
+{
+    const char *fn = "umbra_renderer_render";
+    if (!tf->range_given) {
+        umbra_transfer_function_retain(tf);
+        *out = tf;
+        return UMBRA_SUCCESS;
+    }
+    const double lo = tf->range_lo, hi = tf->range_hi, vmin = value_min, vmax = value_max;
+    const double last = (double)tf->count - 1.0;
+    double n = ceil(TF_RESAMPLE_FACTOR * last * (vmax - vmin) / (hi - lo)) + 1.0;
+    n = fmin(TF_RESAMPLE_MAX, fmax(n, (double)tf->count));
+    const uint32_t count = (uint32_t)n;
+    float *table = malloc((size_t)count * 4 * sizeof *table);
+    if (!table)
+        return umbra__fail(tf->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "%s: out of host memory for a %u-entry transfer function", fn, count);
+    for (uint32_t e = 0; e < count; ++e) {
+        double x = vmin + (vmax - vmin) * (double)e / (double)(count - 1);
+        double s = (x - lo) / (hi - lo) * last;
+        s = fmin(fmax(s, 0.0), last);
+        uint32_t i = (uint32_t)s;
+        i = i + 1 > (uint32_t)last ? (uint32_t)last - 1 : i;
+        double w = s - (double)i;
+        for (int c = 0; c < 4; ++c) {
+            double v = (1.0 - w) * tf->rgba[4 * i + c] + w * tf->rgba[4 * (i + 1) + c];
+            table[4 * e + c] = (float)fmin(1.0, fmax(0.0, v));
+        }
+    }
+    return tf_make(tf->ctx, fn, table, count, out);
+}
+
 uint32_t umbra_transfer_function_size(umbra_transfer_function tf) { return tf ? tf->count : 0; }
 const float *umbra_transfer_function_data(umbra_transfer_function tf) { return tf ? tf->rgba : NULL; }
 

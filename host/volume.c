@@ -167,6 +167,8 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     umbra_context_retain(ctx);
     memcpy(v->dims, desc->dims, sizeof v->dims);
     memcpy(v->spacing, desc->spacing, sizeof v->spacing);
+    if ((st = umbra__volume_set_transform(ctx, desc, v)) != UMBRA_SUCCESS)
+        goto fail;
     v->brick_size = desc->brick_size;
     for (int a = 0; a < 3; ++a)
         v->brick_counts[a] = (v->dims[a] + v->brick_size - 1) / v->brick_size;
@@ -255,6 +257,16 @@ umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
     out->value_max = v->value_max;
     out->brick_size = v->brick_size;
     out->device_bytes = v->device_bytes;
+    out->transform_given = v->transformed;
+    const float zero[3] = {0.0f, 0.0f, 0.0f};
+    double centre[3];
+    umbra__volume_point_to_world(v, zero, centre);
+    for (int a = 0; a < 3; ++a) {
+        out->origin[a] = (float)v->origin[a];
+        out->center[a] = (float)centre[a];
+        for (int k = 0; k < 3; ++k)
+            out->directions[3 * a + k] = (float)v->axes[3 * a + k];
+    }
     return UMBRA_SUCCESS;
 }
 

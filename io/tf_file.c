@@ -3,8 +3,11 @@
  * The format, one item per line:
  *     # a comment, to the end of the line (also after a value)
  *     resolution 256          optional, 2..65536, before the first point; default 256
- *     0.00  0 0 0 0           control points "value r g b a", all in [0,1], values ascending
- *     0.35  1 0.8 0.6 0.05    (equal values make a step)
+ *     range -1024 3071        optional, before the first point: values are data values in
+ *                             [LO, HI] (finite, LO < HI), e.g. Hounsfield units, and the table
+ *                             spans LO..HI (umbra_transfer_function_set_range)
+ *     0.00  0 0 0 0           control points "value r g b a", colour in [0,1], value in [0,1]
+ *     0.35  1 0.8 0.6 0.05    (or [LO, HI]), values ascending (equal values make a step)
  * Blank lines are ignored; at least one point is required. The table itself is built by
  * umbra_transfer_function_create_from_points. Numbers are parsed in the "C" locale, so a decimal
  * point is a '.' whatever locale the application has set. */
@@ -83,7 +86,8 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
     size_t size = 0, count = 0, capacity = 0;
     umbra_tf_point *points = NULL;
     uint32_t resolution = TF_DEFAULT_RESOLUTION;
-    int have_resolution = 0;
+    int have_resolution = 0, have_range = 0;
+    float range_lo = 0.0f, range_hi = 1.0f;
     unsigned long line_no = 0;
     locale_t c_locale = (locale_t)0, previous = (locale_t)0;
 
@@ -168,10 +172,38 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
             continue;
         }
 
+        if (tok[0].n == 5 && memcmp(tok[0].s, "range", 5) == 0) {
+            if (have_range || count > 0) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: %s:%lu: \"%.*s\": range must be given once, before the "
+                                 "first control point",
+                                 __func__, path, line_no, QUOTE_MAX, line);
+                goto fail;
+            }
+            /* An overflowing "1e99" parses to inf and is refused as not finite. */
+            if (ntok != 3 || !parse_float(tok[1], &range_lo) || !parse_float(tok[2], &range_hi) ||
+                !isfinite(range_lo) || !isfinite(range_hi)) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: %s:%lu: \"%.*s\": expected \"range LO HI\" with two "
+                                 "finite numbers",
+                                 __func__, path, line_no, QUOTE_MAX, line);
+                goto fail;
+            }
+            if (!(range_hi > range_lo)) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: %s:%lu: \"%.*s\": range LO %g must be below HI %g",
+                                 __func__, path, line_no, QUOTE_MAX, line, (double)range_lo,
+                                 (double)range_hi);
+                goto fail;
+            }
+            have_range = 1;
+            continue;
+        }
+
         if (ntok != 5) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                              "%s: %s:%lu: \"%.*s\": expected a control point \"value r g b a\" "
-                             "(5 numbers) or \"resolution N\", got %zu fields",
+                             "(5 numbers), \"resolution N\" or \"range LO HI\", got %zu fields",
                              __func__, path, line_no, QUOTE_MAX, line, ntok);
             goto fail;
         }
@@ -211,6 +243,19 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                  tok[i].s);
                 goto fail;
             }
+            if (i == 0 && have_range) {
+                if (v < range_lo || v > range_hi) {
+                    st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                     "%s: %s:%lu: \"%.*s\": value \"%.*s\" is outside the "
+                                     "range [%g, %g]",
+                                     __func__, path, line_no, QUOTE_MAX, line, (int)tok[i].n,
+                                     tok[i].s, (double)range_lo, (double)range_hi);
+                    goto fail;
+                }
+                /* Kept in data units until the table is built (ordering is checked on them). */
+                points[count].value = v;
+                continue;
+            }
             if (v < 0.0f || v > 1.0f) {
                 st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                                  "%s: %s:%lu: \"%.*s\": %s \"%.*s\" is not in [0,1]", __func__,
@@ -239,7 +284,21 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                          "%s: %s: no control points (lines \"value r g b a\")", __func__, path);
         goto fail;
     }
+    if (have_range) {
+        /* Data values to the table's [0,1], in double so that the ends land on 0 and 1. */
+        for (size_t k = 0; k < count; ++k) {
+            double u = ((double)points[k].value - range_lo) / ((double)range_hi - range_lo);
+            points[k].value = (float)(u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u));
+        }
+    }
     st = umbra_transfer_function_create_from_points(ctx, points, (uint32_t)count, resolution, out);
+    if (st == UMBRA_SUCCESS && have_range) {
+        st = umbra_transfer_function_set_range(*out, range_lo, range_hi);
+        if (st != UMBRA_SUCCESS) {
+            umbra_transfer_function_release(*out);
+            *out = NULL;
+        }
+    }
 
 fail:
     if (c_locale != (locale_t)0) {

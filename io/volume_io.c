@@ -232,10 +232,11 @@ void umbra_raw_desc_init(umbra_raw_desc *desc)
     desc->header_bytes = 0;
 }
 
-/* Hands voxels already in host memory to umbra_volume_create. */
+/* Hands voxels already in host memory to umbra_volume_create; origin and directions (9 floats,
+ * unit axis directions) give the index-to-world transform, or are NULL for the centred box. */
 static umbra_status create_volume(umbra_context ctx, const void *data, umbra_scalar_type type,
                                   const uint32_t dims[3], const float spacing[3],
-                                  umbra_volume *out)
+                                  const float *origin, const float *directions, umbra_volume *out)
 {
     umbra_volume_desc vd;
     umbra_volume_desc_init(&vd);
@@ -243,6 +244,11 @@ static umbra_status create_volume(umbra_context ctx, const void *data, umbra_sca
     vd.type = type;
     memcpy(vd.dims, dims, sizeof vd.dims);
     memcpy(vd.spacing, spacing, sizeof vd.spacing);
+    if (origin && directions) {
+        vd.transform_given = 1;
+        memcpy(vd.origin, origin, sizeof vd.origin);
+        memcpy(vd.directions, directions, sizeof vd.directions);
+    }
     return umbra_volume_create(ctx, &vd, out);
 }
 
@@ -327,7 +333,7 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     if (type_size > 1 && (desc->big_endian != 0) != host_is_big_endian()) {
         swap_bytes(voxels, count, type_size);
     }
-    st = create_volume(ctx, voxels, desc->type, desc->dims, desc->spacing, out);
+    st = create_volume(ctx, voxels, desc->type, desc->dims, desc->spacing, NULL, NULL, out);
 
 fail:
     free(voxels);
@@ -406,6 +412,32 @@ static float nrrd_axis_spacing(const Nrrd *nrrd, unsigned int axis)
     return 1.0f;
 }
 
+/* The index-to-world transform of a 3-D space: the space origin (0 where absent) and each axis's
+ * unit space direction, with the directions' lengths as the spacing. Returns 0 (centred box) when
+ * the header has no 3-D space or some axis lacks a finite, non-zero direction. */
+static int nrrd_transform(const Nrrd *nrrd, unsigned int first_axis, float spacing[3],
+                          float origin[3], float directions[9])
+{
+    if (nrrd->spaceDim != 3) {
+        return 0;
+    }
+    for (unsigned int a = 0; a < 3; ++a) {
+        const double *d = nrrd->axis[first_axis + a].spaceDirection;
+        double len = nrrdSpaceVecNorm(3, d);
+        if (!isfinite(len) || !(len > 0.0)) {
+            return 0;
+        }
+        spacing[a] = (float)len;
+        for (unsigned int k = 0; k < 3; ++k) {
+            directions[3 * a + k] = (float)(d[k] / len);
+        }
+    }
+    for (unsigned int k = 0; k < 3; ++k) {
+        origin[k] = isfinite(nrrd->spaceOrigin[k]) ? (float)nrrd->spaceOrigin[k] : 0.0f;
+    }
+    return 1;
+}
+
 /* A 4-D array whose first axis has size 1 (a one-component "vector" volume, as some tools
  * write) is accepted as the 3-D volume it is. */
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
@@ -415,7 +447,7 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
     char *biff_msg = NULL;
     umbra_scalar_type type = UMBRA_UINT8;
     uint32_t dims[3];
-    float spacing[3];
+    float spacing[3], origin[3], directions[9];
     unsigned int first_axis = 0, i;
     int load_failed, verbose;
     locale_switch loc;
@@ -496,7 +528,12 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         dims[i] = (uint32_t)size;
         spacing[i] = nrrd_axis_spacing(nrrd, first_axis + i);
     }
-    st = create_volume(ctx, nrrd->data, type, dims, spacing, out);
+    /* The world is the header's space as written (e.g. LPS for DICOM-derived scans). */
+    if (nrrd_transform(nrrd, first_axis, spacing, origin, directions)) {
+        st = create_volume(ctx, nrrd->data, type, dims, spacing, origin, directions, out);
+    } else {
+        st = create_volume(ctx, nrrd->data, type, dims, spacing, NULL, NULL, out);
+    }
 
 fail:
     free(biff_msg);

@@ -425,6 +425,68 @@ static void test_nrrd_attached_space_directions_give_spacing(void **state)
     remove(path);
 }
 
+/* Space origin and space directions give the index-to-world transform: the directions' lengths
+ * are the spacing, their unit vectors the axes (here a turn with a mirror, as LPS files have). */
+static void test_nrrd_space_origin_and_directions_give_world(void **state)
+{
+    umbra_context ctx = *state;
+    char path[PATH_MAX_LEN];
+    static const char header[] = "NRRD0004\n"
+                                 "type: uchar\n"
+                                 "dimension: 3\n"
+                                 "space: left-posterior-superior\n"
+                                 "sizes: 2 2 2\n"
+                                 "space directions: (0,0.5,0) (-2,0,0) (0,0,3)\n"
+                                 "space origin: (10,-20,30.5)\n"
+                                 "encoding: raw\n"
+                                 "\n";
+    static const unsigned char voxels[8] = {10, 20, 30, 40, 50, 60, 70, 90};
+    static const float spacing[3] = {0.5f, 2.0f, 3.0f};
+    static const float dirs[9] = {0, 1, 0, -1, 0, 0, 0, 0, 1};
+    /* origin + (d0 s0 + d1 s1 + d2 s2) (2 - 1) / 2 */
+    static const float centre[3] = {9.0f, -19.75f, 32.0f};
+    unsigned char file[sizeof header - 1 + 8];
+    umbra_volume vol = NULL;
+    umbra_volume_info info;
+    size_t i;
+    memcpy(file, header, sizeof header - 1);
+    memcpy(file + sizeof header - 1, voxels, 8);
+    write_bytes(tmp_path(path, "world.nrrd"), file, sizeof file);
+    assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
+    assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
+    assert_int_equal(info.transform_given, 1);
+    assert_float_equal(info.origin[0], 10.0, 1e-6);
+    assert_float_equal(info.origin[1], -20.0, 1e-6);
+    assert_float_equal(info.origin[2], 30.5, 1e-6);
+    for (i = 0; i < 3; ++i) {
+        assert_float_equal(info.spacing[i], spacing[i], 1e-6);
+        assert_float_equal(info.center[i], centre[i], 1e-5);
+    }
+    for (i = 0; i < 9; ++i) {
+        assert_float_equal(info.directions[i], dirs[i], 1e-6);
+    }
+    umbra_volume_release(vol);
+
+    /* Without space directions the box stays centred. */
+    write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspacings: 1 2 3\n"
+                     "encoding: raw\n\n12345678");
+    assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
+    assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
+    assert_int_equal(info.transform_given, 0);
+    assert_float_equal(info.center[0], 0.0, 0.0);
+    assert_float_equal(info.origin[2], -1.5, 1e-6);
+    umbra_volume_release(vol);
+
+    /* A sheared grid (axes 45 degrees apart, as a tilted CT gantry makes) is refused. */
+    write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nspace: 3D-right-handed\n"
+                     "sizes: 2 2 2\nspace directions: (1,0,0) (1,1,0) (0,0,1)\n"
+                     "encoding: raw\n\n12345678");
+    assert_failed(ctx, umbra_volume_load(ctx, path, &vol), UMBRA_ERROR_UNSUPPORTED,
+                  "index axes 0 and 1 meet at 45.000 degrees", "sheared");
+    assert_null(vol);
+    remove(path);
+}
+
 static void test_nrrd_4d_with_leading_size1_axis_loads(void **state)
 {
     umbra_context ctx = *state;
@@ -824,6 +886,74 @@ static void test_tf_file_bad_resolution_rejected(void **state)
     remove(path);
 }
 
+/* "range LO HI": point values are data values in [LO, HI] and the table spans that range. */
+static void test_tf_file_range_in_data_units(void **state)
+{
+    umbra_context ctx = *state;
+    char path[PATH_MAX_LEN];
+    umbra_transfer_function tf = NULL;
+    float range[2];
+    static const float alpha[5] = {0.0f, 0.0f, 0.5f, 1.0f, 1.0f}; /* at 0, 100, .., 400 */
+    uint32_t i;
+    write_text(tmp_path(path, "hu.tf"), "# Hounsfield-like units\n"
+                                        "range 0 400   # data units\n"
+                                        "resolution 5\n"
+                                        "100 0 0 0 0\n"
+                                        "300 1 1 1 1\n");
+    assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
+    assert_int_equal(umbra_transfer_function_get_range(tf, range), 1);
+    assert_float_equal(range[0], 0.0, 0.0);
+    assert_float_equal(range[1], 400.0, 0.0);
+    assert_int_equal(umbra_transfer_function_size(tf), 5);
+    for (i = 0; i < 5; ++i) {
+        assert_float_equal(umbra_transfer_function_data(tf)[4 * i + 3], alpha[i], 1e-6);
+    }
+    umbra_transfer_function_release(tf);
+    tf = NULL;
+    /* Without the line there is no range. */
+    write_text(path, "0 0 0 0 0\n1 1 1 1 1\n");
+    assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
+    assert_int_equal(umbra_transfer_function_get_range(tf, range), 0);
+    umbra_transfer_function_release(tf);
+    remove(path);
+}
+
+static void test_tf_file_bad_range_rejected(void **state)
+{
+    umbra_context ctx = *state;
+    char path[PATH_MAX_LEN], needle[PATH_MAX_LEN + 8];
+    umbra_transfer_function tf = NULL;
+    static const struct {
+        const char *text, *message;
+        int line;
+    } cases[] = {
+        {"range 5 5\n5 0 0 0 0\n", "range LO 5 must be below HI 5", 1},
+        {"range 3071 -1024\n0 0 0 0 0\n", "range LO 3071 must be below HI -1024", 1},
+        {"range nan 1\n0 0 0 0 0\n", "two finite numbers", 1},
+        {"range 0 inf\n0 0 0 0 0\n", "two finite numbers", 1},
+        {"range 0 1e99\n0 0 0 0 0\n", "two finite numbers", 1},
+        {"range 0\n0 0 0 0 0\n", "\"range LO HI\"", 1},
+        {"range 0 1 2\n0 0 0 0 0\n", "\"range LO HI\"", 1},
+        {"range 0 x\n0 0 0 0 0\n", "two finite numbers", 1},
+        {"0 0 0 0 0\nrange 0 1\n", "before the first control point", 2},
+        {"range 0 1\nrange 0 2\n0 0 0 0 0\n", "once", 2},
+        {"range 0 400\n100 0 0 0 0\n401 1 1 1 1\n", "value \"401\" is outside the range [0, 400]", 3},
+        {"range -1024 3071\n-2000 0 0 0 0\n", "outside the range [-1024, 3071]", 2},
+        {"range 0 400\n300 0 0 0 0\n200 1 1 1 1\n", "ascending", 3},
+        {"range 0 400\n100 2 0 0 0\n", "red \"2\" is not in [0,1]", 2},
+    };
+    size_t i;
+    tmp_path(path, "bad_range.tf");
+    for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        write_text(path, cases[i].text);
+        snprintf(needle, sizeof needle, "%s:%d:", path, cases[i].line);
+        assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
+                      needle, cases[i].message);
+        assert_null(tf);
+    }
+    remove(path);
+}
+
 static void test_tf_file_without_points_rejected(void **state)
 {
     umbra_context ctx = *state;
@@ -1202,6 +1332,7 @@ int main(void)
         IO_TEST(test_raw_invalid_desc_is_invalid_argument),
         IO_TEST(test_nrrd_detached_header_loads),
         IO_TEST(test_nrrd_attached_space_directions_give_spacing),
+        IO_TEST(test_nrrd_space_origin_and_directions_give_world),
         IO_TEST(test_nrrd_4d_with_leading_size1_axis_loads),
         IO_TEST(test_nrrd_broken_header_is_format_error),
         IO_TEST(test_nrrd_missing_data_file_is_format_error),
@@ -1217,6 +1348,8 @@ int main(void)
         IO_TEST(test_tf_file_default_resolution_is_256),
         IO_TEST(test_tf_file_bad_line_names_line_number),
         IO_TEST(test_tf_file_nan_rejected),
+        IO_TEST(test_tf_file_range_in_data_units),
+        IO_TEST(test_tf_file_bad_range_rejected),
         IO_TEST(test_tf_file_out_of_range_or_descending_rejected),
         IO_TEST(test_tf_file_bad_resolution_rejected),
         IO_TEST(test_tf_file_without_points_rejected),

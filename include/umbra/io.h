@@ -24,13 +24,16 @@ extern "C" {
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
- * short and float; 3-D, or 4-D with a size-1 first axis. Spacing comes from the header's spacings
- * or space directions (1 where absent). */
+ * short and float; 3-D, or 4-D with a size-1 first axis. With "space directions" the spacing is
+ * each direction's length and the volume carries the index-to-world transform (space origin, 0
+ * where absent, and the unit directions); a sheared grid is UMBRA_ERROR_UNSUPPORTED. Without them
+ * the spacing comes from the header's spacings (1 where absent) and the box is centred. */
 UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads a Voreen .dat header and its raw file, which is looked up relative to the .dat's
  * directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
- * are required; ObjectModel, if present, must be I. */
+ * are required; ObjectModel, if present, must be I. SliceThickness is the spacing; the format
+ * has no origin, so the box is centred. */
 UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
 
 typedef struct umbra_raw_desc {
@@ -51,9 +54,11 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
 
 /* ---- transfer functions ---------------------------------------------------------------------- */
 
-/* Reads the text format documented in the README (and io/tf_file.c): '#' comments, an optional
- * line "resolution N" (default 256) before the first point, then one control point
- * "value r g b a" per line, values ascending (equal values make a step). */
+/* Reads the text format documented in the README (and io/tf_file.c): '#' comments, optional
+ * lines "resolution N" (default 256) and "range LO HI" (finite, LO < HI) before the first point,
+ * then one control point "value r g b a" per line, values ascending (equal values make a step):
+ * in [0,1] of the volume's normalised range, or with a range, data values in [LO, HI].
+ * UMBRA_ERROR_FORMAT names the line and value for anything else. */
 UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                                     umbra_transfer_function *out);
 

@@ -1,9 +1,11 @@
 /* umbra/renderer.h: direct volume rendering with shadows.
  *
  * A renderer draws one volume with a view transfer function from a camera, lit by one light, and
- * takes a per-sample RGB shadow factor from the selected shadow technique. Setters copy their
- * arguments and mark what changed; render() rebuilds only what the change calls for (moving the
- * camera re-uses a shadow map built for the same light, volume and light transfer function).
+ * takes a per-sample RGB shadow factor from the selected shadow technique. Camera, light, ground
+ * plane and query points are in the volume's world (volume.h: the centred box unless the volume
+ * carries an index-to-world transform). Setters copy their arguments and mark what changed;
+ * render() rebuilds only what the change calls for (moving the camera re-uses a shadow map built
+ * for the same light, volume and light transfer function).
  *
  * Shading model, shared by every technique. A sample of (step-corrected) opacity a and
  * transmission colour t passes the fraction 1 - a (1 - t_c) of light channel c (the CSSM paper's
@@ -35,7 +37,9 @@ typedef enum umbra_projection {
     UMBRA_ORTHOGRAPHIC = 1
 } umbra_projection;
 
-/* A look-at camera in world space (the volume's box is centred on the origin). */
+/* A look-at camera in the volume's world (volume.h: the box is centred on the origin unless the
+ * volume carries an index-to-world transform). Distances and steps keep their meaning: the
+ * transform is rigid. */
 typedef struct umbra_camera {
     umbra_projection projection;
     float eye[3];
@@ -45,9 +49,12 @@ typedef struct umbra_camera {
     float ortho_height;   /* orthographic: height of the view in world units, > 0 */
 } umbra_camera;
 
-/* A camera looking at the volume's centre from direction dir (need not be normalised) at a
- * distance that frames a box of the given diagonal. */
+/* A camera looking at the world origin (the centred box's centre) from direction dir (need not
+ * be normalised) at a distance that frames a box of the given diagonal; up is +y. */
 UMBRA_API umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees);
+/* The same around center (world units), e.g. umbra_volume_info.center of a transformed volume. */
+UMBRA_API umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], float box_diagonal,
+                                             float fovy_degrees);
 
 typedef enum umbra_light_type {
     UMBRA_LIGHT_POINT = 0,
@@ -56,8 +63,9 @@ typedef enum umbra_light_type {
 
 typedef struct umbra_light {
     umbra_light_type type;
-    float position[3];   /* point light, world space; may lie inside the volume */
-    float direction[3];  /* directional light: the direction light travels in (need not be unit) */
+    float position[3];   /* point light, in the volume's world; may lie inside the volume */
+    float direction[3];  /* directional light: the direction light travels in, in the volume's
+                            world (need not be unit) */
     float color[3];      /* RGB intensity, each >= 0 */
 } umbra_light;
 
@@ -78,10 +86,13 @@ typedef struct umbra_render_desc {
     float kd, ks, shininess; /* Blinn-Phong coefficients (defaults 0.8, 0.3, 32) */
     float ambient[3];        /* ambient light (default 0.2 each) */
     float background[4];     /* premultiplied RGBA behind everything (default 0,0,0,0) */
-    int ground_plane;        /* nonzero: opaque plane under the volume receives shadows */
+    int ground_plane;        /* nonzero: opaque plane under the volume receives shadows; it is
+                                horizontal (normal +y) in the volume's world, also when the
+                                volume is rotated */
     float ground_color[3];   /* default 0.8 each */
-    float ground_offset;     /* gap between the box's lowest y and the plane, as a fraction of
-                                the box diagonal (default 0.02; negative lifts it into the box) */
+    float ground_offset;     /* gap between the box's lowest world y (its lowest corner) and
+                                the plane, as a fraction of the box diagonal (default 0.02;
+                                negative lifts it into the box) */
     umbra_transmission transmission; /* default UMBRA_TRANSMISSION_GREY */
 } umbra_render_desc;
 
@@ -199,8 +210,8 @@ UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r
                                                                 cl_uint num_wait, const cl_event *wait_list,
                                                                 cl_event *done);
 
-/* Evaluates the current technique's shadow factor at count world-space points (3 floats each,
- * borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
+/* Evaluates the current technique's shadow factor at count points in the volume's world (3 floats
+ * each, borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
 UMBRA_API umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
                                                    float *rgb);
 

@@ -1,8 +1,12 @@
 /* umbra/transfer_function.h: 1D RGBA transfer functions.
  *
  * A transfer function is a table of RGBA entries spread evenly over the volume's normalised value
- * range [0,1] (entry i at value i/(count-1)), linearly interpolated. Alpha is the opacity of one
- * sample taken every voxel (the reference step); renderers correct it for their own step with
+ * range [0,1] (entry i at value i/(count-1)), linearly interpolated. Given a data range
+ * (umbra_transfer_function_set_range, or "range LO HI" in a file) the entries span data values
+ * LO..HI instead, in the volume's own units (e.g. Hounsfield units), whatever the volume's value
+ * range: the renderer resamples the table onto each volume's range, and data values outside
+ * LO..HI take the end entries. Alpha is the opacity of one sample taken every voxel (the
+ * reference step); renderers correct it for their own step with
  * a' = 1 - (1 - a)^(step / reference_step). RGB is the emitted colour for the view, and for a light
  * transfer function in UMBRA_TRANSMISSION_COLORED mode the transmission colour t of the shading
  * model (see renderer.h). */
@@ -35,6 +39,13 @@ UMBRA_API umbra_status umbra_transfer_function_create_from_points(umbra_context 
                                                                   const umbra_tf_point *points,
                                                                   uint32_t count, uint32_t resolution,
                                                                   umbra_transfer_function *out);
+
+/* Makes tf's entries span data values lo..hi (finite, lo < hi; the volume's units, before its
+ * normalisation) instead of the volume's normalised range; renderers pick the change up at their
+ * next render. The table itself is unchanged. UMBRA_ERROR_INVALID_ARGUMENT names a bad range. */
+UMBRA_API umbra_status umbra_transfer_function_set_range(umbra_transfer_function tf, float lo, float hi);
+/* Nonzero if tf has a data range; then writes it to range[0..1] (range may be NULL). */
+UMBRA_API int umbra_transfer_function_get_range(umbra_transfer_function tf, float range[2]);
 
 UMBRA_API uint32_t umbra_transfer_function_size(umbra_transfer_function tf);
 /* The table, 4*size floats, owned by tf. */

@@ -1,9 +1,18 @@
 /* umbra/volume.h: scalar volumes on the device.
  *
  * A volume is a regular grid of scalars, x fastest, uploaded once. Values are mapped to [0,1]
- * through a value range (given, or the data's min and max) before transfer-function lookup. The
- * volume's box in world space is centred on the origin and measures dims * spacing. Per-brick
- * min/max values (bricks of brick_size^3 voxels) are kept for empty-space skipping. */
+ * through a value range (given, or the data's min and max) before transfer-function lookup.
+ * Per-brick min/max values (bricks of brick_size^3 voxels) are kept for empty-space skipping.
+ *
+ * World coordinates. Samples are cell centres: the volume's box reaches half a voxel beyond the
+ * outer samples and measures dims * spacing. By default the box is centred on the world origin
+ * with index axes i, j, k along x, y, z, so voxel (i, j, k) lies at
+ *     ((i + 0.5 - dims[0]/2) spacing[0], (j + 0.5 - dims[1]/2) spacing[1], ...).
+ * With an index-to-world transform (desc.transform_given, or a NRRD's space origin and space
+ * directions) voxel (i, j, k) lies at
+ *     origin + i spacing[0] d0 + j spacing[1] d1 + k spacing[2] d2
+ * for unit, mutually orthogonal axis directions d0, d1, d2 (a rotation, or a rotation with a
+ * mirror). The renderer's camera, light, ground plane and query points are in this world. */
 #ifndef UMBRA_VOLUME_H
 #define UMBRA_VOLUME_H
 
@@ -37,6 +46,13 @@ typedef struct umbra_volume_desc {
     int value_range_given;   /* 0 (default): value range is the data's min and max */
     float value_min, value_max; /* with value_range_given: maps value_min to 0, value_max to 1 */
     uint32_t brick_size;     /* edge of an empty-space-skipping brick in voxels (default 16) */
+    /* Index-to-world transform (see the top of this file). 0 (default): the centred box. */
+    int transform_given;
+    float origin[3];         /* world position of voxel (0, 0, 0)'s centre */
+    float directions[9];     /* world direction of index axis a in directions[3a .. 3a+2]; each
+                                non-zero (normalised here) and at most 0.06 degrees from a
+                                right angle to the others (snapped to exact right angles); a
+                                sheared grid is UMBRA_ERROR_UNSUPPORTED naming the angle */
 } umbra_volume_desc;
 
 UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
@@ -53,6 +69,12 @@ typedef struct umbra_volume_info {
     uint32_t brick_size;
     uint32_t brick_counts[3];
     size_t device_bytes;     /* device memory held by the volume and its brick table */
+    int transform_given;     /* nonzero if the volume was made with an index-to-world transform */
+    float origin[3];         /* world position of voxel (0, 0, 0)'s centre (also for the centred
+                                box: (0.5 - dims/2) * spacing) */
+    float directions[9];     /* unit world direction of index axis a in directions[3a .. 3a+2]
+                                (the identity for the centred box) */
+    float center[3];         /* world position of the box's centre (0 for the centred box) */
 } umbra_volume_info;
 
 UMBRA_API umbra_status umbra_volume_get_info(umbra_volume volume, umbra_volume_info *out);
