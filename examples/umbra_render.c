@@ -16,9 +16,11 @@ static void usage(FILE *f)
         "  --version             print the version and exit\n"
         "  --scene NAME          built-in scene: spheres (default), slab, marschner-lobb\n"
         "  --scene-size N        built-in scene resolution N^3 (default per scene)\n"
-        "  --volume FILE         volume file: .nrrd/.nhdr (Teem) or .dat (Voreen)\n"
+        "  --volume FILE         volume file: .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI), .dat (Voreen)\n"
         "  --raw FILE --raw-dims XxYxZ --raw-type uint8|uint16|int16|float32 [--raw-big-endian]\n"
-        "  --tf FILE             transfer function (text format, see README)\n"
+        "  --tf FILE             transfer function: text format (see README) or a ParaView\n"
+        "                        preset .json (x in the volume's data units)\n"
+        "  --tf-preset NAME      the preset to pick from a .json holding several\n"
         "  --light-tf FILE       separate transfer function for the light pass\n"
         "  --size WxH            image size (default 512x512)\n"
         "  --out FILE            output image, .png or .exr (default umbra.png)\n"
@@ -99,7 +101,7 @@ static void on_error(void *user, umbra_status st, const char *msg)
     } while (0)
 
 typedef struct options {
-    const char *scene, *volume, *raw, *tf, *light_tf, *out, *device;
+    const char *scene, *volume, *raw, *tf, *tf_preset, *light_tf, *out, *device;
     uint32_t scene_size, width, height;
     umbra_raw_desc raw_desc;
     int have_raw_dims, have_raw_type;
@@ -163,6 +165,7 @@ static int parse_args(int argc, char **argv, options *o)
             o->have_raw_type = 1;
         } else if (FLAG("--raw-big-endian")) o->raw_desc.big_endian = 1;
         else if (FLAG("--tf")) { NEED(); o->tf = v; }
+        else if (FLAG("--tf-preset")) { NEED(); o->tf_preset = v; }
         else if (FLAG("--light-tf")) { NEED(); o->light_tf = v; }
         else if (FLAG("--size")) { NEED(); if (!parse_size(v, &o->width, &o->height)) BAD("--size '%s' is not WxH with sides in [1, 16384]", v); }
         else if (FLAG("--out")) { NEED(); o->out = v; }
@@ -238,6 +241,27 @@ static void session_end(session *s)
     umbra_context_release(s->ctx);
 }
 
+/* A ParaView preset's x values are data values: its table is made to span the volume's value
+ * range, which the volume normalises to [0,1]. Other files are umbra's text format. */
+static umbra_status load_tf(umbra_context ctx, const char *path, const char *preset,
+                            umbra_volume vol, umbra_transfer_function *out)
+{
+    size_t n = strlen(path);
+    if (n > 5 && strcmp(path + n - 5, ".json") == 0) {
+        umbra_paraview_options po;
+        umbra_volume_info info;
+        umbra_paraview_options_init(&po);
+        po.preset = preset;
+        if (umbra_volume_get_info(vol, &info) == UMBRA_SUCCESS && info.value_max > info.value_min) {
+            po.range_given = 1;
+            po.range_min = info.value_min;
+            po.range_max = info.value_max;
+        }
+        return umbra_transfer_function_load_paraview(ctx, path, &po, out, NULL);
+    }
+    return umbra_transfer_function_load(ctx, path, out);
+}
+
 static int run(const options *o, session *s)
 {
     umbra_context_desc cd;
@@ -294,11 +318,11 @@ static int run(const options *o, session *s)
         rd = s->scene.options;
     }
     if (o->tf) {
-        if (umbra_transfer_function_load(s->ctx, o->tf, &s->tf) != UMBRA_SUCCESS)
+        if (load_tf(s->ctx, o->tf, o->tf_preset, vol, &s->tf) != UMBRA_SUCCESS)
             return 1;
         tf = s->tf;
     }
-    if (o->light_tf && umbra_transfer_function_load(s->ctx, o->light_tf, &s->light_tf) != UMBRA_SUCCESS)
+    if (o->light_tf && load_tf(s->ctx, o->light_tf, o->tf_preset, vol, &s->light_tf) != UMBRA_SUCCESS)
         return 1;
 
     if (o->have_camera_dir) {
