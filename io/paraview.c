@@ -589,7 +589,17 @@ umbra_status umbra_transfer_function_load_paraview(umbra_context ctx, const char
                          size, PV_MAX_FILE_BYTES);
         goto fail;
     }
-    root = cJSON_ParseWithLengthOpts(buf, size, &end, 1);
+    /* With require_null_terminated cJSON wants the terminating NUL inside the length; a NUL
+     * within the file would end the text early, so it is refused first. */
+    if (memchr(buf, '\0', size)) {
+        unsigned long line = 0, col = 0;
+        text_position(buf, (size_t)((const char *)memchr(buf, '\0', size) - (const char *)buf),
+                      &line, &col);
+        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: %s:%lu:%lu: NUL byte (not a text file?)",
+                         __func__, path, line, col);
+        goto fail;
+    }
+    root = cJSON_ParseWithLengthOpts(buf, size + 1, &end, 1);
     if (!root) {
         unsigned long line = 0, col = 0;
         size_t off = (end && end >= (const char *)buf && end <= (const char *)buf + size)
