@@ -956,6 +956,7 @@ static void test_cli_renders_nifti_with_preset(void **state)
     assert_int_equal(h, 64);
     {
         const float *centre = rgba + 4 * (32 * 64 + 32), *corner = rgba;
+        const float *tissue = rgba + 4 * (37 * 64 + 15);
         print_message("centre %g %g %g, corner %g %g %g\n", (double)centre[0],
                       (double)centre[1], (double)centre[2], (double)corner[0], (double)corner[1],
                       (double)corner[2]);
@@ -963,6 +964,11 @@ static void test_cli_renders_nifti_with_preset(void **state)
         assert_true(centre[0] > 0.2f && centre[0] > centre[1] && centre[1] > centre[2]);
         assert_float_equal(corner[0], 0.08, 0.01);
         assert_float_equal(corner[2], 0.10, 0.01);
+        /* Inside the box's outline, beside the ball: the soft tissue is nearly clear. Placed over
+         * the preset's own range instead of the volume's, 40 HU would land at 913 HU and the box
+         * would be an opaque white cube: this pixel 0.27 instead of 0.12 (linear). */
+        print_message("tissue %g\n", (double)tissue[0]);
+        assert_true(tissue[0] < 0.19f);
     }
     free(rgba);
 }
