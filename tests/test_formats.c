@@ -263,6 +263,9 @@ static void test_paraview_midpoint_and_sharpness(void **state)
     t = umbra_transfer_function_data(tf);
     assert_float_equal(t[4 * 50 + 3], 0.5, 1e-6);
     assert_true(t[4 * 20 + 3] < 0.2f);
+    /* At x = 0.2 VTK's curve compresses s to 0.5 (2 s)^(1 + 10 sharpness) = 0.002048, then the
+     * Hermite blend with tangents (1 - sharpness)(y2 - y1) gives 0.00103028. */
+    assert_float_equal(t[4 * 20 + 3], 0.00103028, 1e-7);
     assert_true(t[4 * 80 + 3] > 0.8f);
     {
         int i;
