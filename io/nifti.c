@@ -244,6 +244,8 @@ umbra_status umbra__nifti_read(umbra_context ctx, const char *func, const char *
     } else {
         out->transform = UMBRA__NIFTI_PIXDIM;
         for (c = 0; c < 3; ++c) {
+            /* nifticlib already reads a pixdim of 0 as 1 and drops the sign (tested); kept so the
+             * matrix stays valid whatever a future nifticlib does. */
             double d = fabs(nim->pixdim[c + 1]);
             out->index_to_world[c][c] = d > 0.0 ? d : 1.0;
         }

@@ -40,8 +40,8 @@ UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path
  * (rounded to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope
  * other than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's
  * real values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform
- * (when sform_code > 0), else the qform (qform_code > 0), else |pixdim| (0 read as 1), in the
- * file's units. The header's sizes are checked against the file before the voxels are read. */
+ * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
+ * the file's units. MetaImage and VTK .vti are not supported (no small maintained library). The header's sizes are checked against the file before the voxels are read. */
 UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
                                                umbra_volume *out);
 
