@@ -19,11 +19,14 @@
  * sharpness, Lab and diverging blends) come out as ParaView draws them.
  *
  * JSON is parsed by cJSON (Debian's libcjson). Every size a file controls is bounded: the file
- * (PV_MAX_FILE_BYTES), the points per array (PV_MAX_POINTS), JSON nesting (cJSON's own limit). */
+ * (PV_MAX_FILE_BYTES), the points per array (PV_MAX_POINTS), JSON nesting (cJSON's own limit).
+ * cJSON's parser writes a process-wide error record on every call, so parses are serialised by
+ * one lock (the tree it returns is the caller's alone). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +44,9 @@
 /* Messages quote at most this much of a name taken from a file. */
 #define QUOTE_MAX 200
 #define PV_PI 3.14159265358979323846
+
+/* Serialises cJSON_Parse* (its global error record); see the top of the file. */
+static pthread_mutex_t cjson_lock = PTHREAD_MUTEX_INITIALIZER;
 
 typedef enum pv_space { PV_RGB, PV_LAB, PV_DIVERGING, PV_STEP } pv_space;
 
@@ -599,7 +605,9 @@ umbra_status umbra_transfer_function_load_paraview(umbra_context ctx, const char
                          __func__, path, line, col);
         goto fail;
     }
+    pthread_mutex_lock(&cjson_lock);
     root = cJSON_ParseWithLengthOpts(buf, size + 1, &end, 1);
+    pthread_mutex_unlock(&cjson_lock);
     if (!root) {
         unsigned long line = 0, col = 0;
         size_t off = (end && end >= (const char *)buf && end <= (const char *)buf + size)

@@ -7,7 +7,8 @@
  * then broken byte by byte); loaded volumes are read back from the device. Every refusal is
  * checked for its status, a message naming the problem, and a usable context afterwards. The last
  * test runs umbra-render (./umbra-render in ctest's working directory, or $UMBRA_RENDER) on a
- * NIfTI file and a preset written here. */
+ * NIfTI file and a preset written here. One file past 800 lines because the two formats share
+ * the helpers and the last test needs both; it is a table of cases more than code. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
