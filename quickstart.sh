@@ -7,7 +7,8 @@ cd "$(dirname "$0")"
 build=${1:-build}
 
 packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-headers opencl-c-headers
-          pocl-opencl-icd libteem-dev libopenimageio-dev libcmocka-dev gnuplot-nox)
+          pocl-opencl-icd libteem-dev libopenimageio-dev libnifti2-dev libcjson-dev
+          libcmocka-dev gnuplot-nox)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

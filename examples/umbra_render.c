@@ -16,9 +16,11 @@ static void usage(FILE *f)
         "  --version             print the version and exit\n"
         "  --scene NAME          built-in scene: spheres (default), slab, marschner-lobb\n"
         "  --scene-size N        built-in scene resolution N^3 (default per scene)\n"
-        "  --volume FILE         volume file: .nrrd/.nhdr (Teem) or .dat (Voreen)\n"
+        "  --volume FILE         volume file: .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI), .dat (Voreen)\n"
         "  --raw FILE --raw-dims XxYxZ --raw-type uint8|uint16|int16|float32 [--raw-big-endian]\n"
-        "  --tf FILE             transfer function (text format, see README)\n"
+        "  --tf FILE             transfer function: text format (see README) or a ParaView\n"
+        "                        preset .json (x in the volume's data units)\n"
+        "  --tf-preset NAME      the preset to pick from a .json holding several\n"
         "  --light-tf FILE       separate transfer function for the light pass\n"
         "  --tf-range LO,HI      the transfer functions span data values LO..HI (overrides a\n"
         "                        file's range line: an HU preset on data stored as HU + 1024\n"
@@ -103,7 +105,7 @@ static void on_error(void *user, umbra_status st, const char *msg)
     } while (0)
 
 typedef struct options {
-    const char *scene, *volume, *raw, *tf, *light_tf, *out, *device;
+    const char *scene, *volume, *raw, *tf, *tf_preset, *light_tf, *out, *device;
     uint32_t scene_size, width, height;
     umbra_raw_desc raw_desc;
     int have_raw_dims, have_raw_type;
@@ -169,6 +171,7 @@ static int parse_args(int argc, char **argv, options *o)
             o->have_raw_type = 1;
         } else if (FLAG("--raw-big-endian")) o->raw_desc.big_endian = 1;
         else if (FLAG("--tf")) { NEED(); o->tf = v; }
+        else if (FLAG("--tf-preset")) { NEED(); o->tf_preset = v; }
         else if (FLAG("--light-tf")) { NEED(); o->light_tf = v; }
         else if (FLAG("--tf-range")) { NEED(); if (!parse_floats(v, o->tf_range, 2)) BAD("--tf-range '%s' is not LO,HI", v); o->have_tf_range = 1; }
         else if (FLAG("--size")) { NEED(); if (!parse_size(v, &o->width, &o->height)) BAD("--size '%s' is not WxH with sides in [1, 16384]", v); }
@@ -245,6 +248,21 @@ static void session_end(session *s)
     umbra_context_release(s->ctx);
 }
 
+/* A ParaView preset (its x values are data values: the loaded table carries that range) or
+ * umbra's text format. */
+static umbra_status load_tf(umbra_context ctx, const char *path, const char *preset,
+                            umbra_transfer_function *out)
+{
+    size_t n = strlen(path);
+    if (n > 5 && strcmp(path + n - 5, ".json") == 0) {
+        umbra_paraview_options po;
+        umbra_paraview_options_init(&po);
+        po.preset = preset;
+        return umbra_transfer_function_load_paraview(ctx, path, &po, out, NULL);
+    }
+    return umbra_transfer_function_load(ctx, path, out);
+}
+
 static int run(const options *o, session *s)
 {
     umbra_context_desc cd;
@@ -302,11 +320,11 @@ static int run(const options *o, session *s)
         rd = s->scene.options;
     }
     if (o->tf) {
-        if (umbra_transfer_function_load(s->ctx, o->tf, &s->tf) != UMBRA_SUCCESS)
+        if (load_tf(s->ctx, o->tf, o->tf_preset, &s->tf) != UMBRA_SUCCESS)
             return 1;
         tf = s->tf;
     }
-    if (o->light_tf && umbra_transfer_function_load(s->ctx, o->light_tf, &s->light_tf) != UMBRA_SUCCESS)
+    if (o->light_tf && load_tf(s->ctx, o->light_tf, o->tf_preset, &s->light_tf) != UMBRA_SUCCESS)
         return 1;
     /* The library checks LO < HI and names the values. */
     if (o->have_tf_range &&

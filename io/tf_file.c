@@ -98,6 +98,9 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
     if (!ctx) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
     }
+    if (path && strlen(path) > 5 && strcmp(path + strlen(path) - 5, ".json") == 0) {
+        return umbra_transfer_function_load_paraview(ctx, path, NULL, out, NULL);
+    }
     st = umbra__read_file(ctx, __func__, path, &buf, &size);
     if (st != UMBRA_SUCCESS) {
         goto fail;

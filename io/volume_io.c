@@ -748,8 +748,14 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
     if (equal_nocase(ext, strlen(ext), "dat")) {
         return umbra_volume_load_dat(ctx, path, out);
     }
+    if (equal_nocase(ext, strlen(ext), "nii") ||
+        (equal_nocase(ext, strlen(ext), "gz") && strlen(path) >= 7 &&
+         equal_nocase(path + strlen(path) - 7, 7, ".nii.gz"))) {
+        return umbra_volume_load_nifti(ctx, path, out);
+    }
     return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                       "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD) and "
-                       ".dat (Voreen); load headerless raw files with umbra_volume_load_raw",
+                       "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD), .nii, "
+                       ".nii.gz (NIfTI) and .dat (Voreen); MetaImage (.mha, .mhd) and VTK (.vti) "
+                       "are not supported; load headerless raw files with umbra_volume_load_raw",
                        __func__, path);
 }

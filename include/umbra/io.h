@@ -1,11 +1,12 @@
-/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, Voreen .dat and raw files,
- * transfer functions from text files, images to and from PNG and EXR.
+/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, Voreen .dat and raw
+ * files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
+ * EXR.
  *
  * It is a library of its own (libumbra_io, CMake target umbra::io, pkg-config umbra-io) that links
- * Teem and OpenImageIO, so that libumbra itself depends on OpenCL and the C library only. It is
- * built on libumbra's public API: whatever it loads an application could also hand to
- * umbra_volume_create or umbra_transfer_function_create itself. Errors are recorded on the
- * context like every umbra error. Readers open regular files only. */
+ * Teem, OpenImageIO, nifticlib and cJSON, so that libumbra itself depends on OpenCL and the C
+ * library only. It is built on libumbra's public API: whatever it loads an application could
+ * also hand to umbra_volume_create or umbra_transfer_function_create itself. Errors are recorded
+ * on the context like every umbra error. Readers open regular files only. */
 #ifndef UMBRA_IO_H
 #define UMBRA_IO_H
 
@@ -20,7 +21,7 @@ extern "C" {
 
 /* ---- volumes --------------------------------------------------------------------------------- */
 
-/* Loads a volume by file extension: .nrrd / .nhdr (Teem), .dat (Voreen). */
+/* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .dat (Voreen). */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
@@ -35,6 +36,17 @@ UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *pat
  * are required; ObjectModel, if present, must be I. SliceThickness is the spacing; the format
  * has no origin, so the box is centred. */
 UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
+
+/* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz) through
+ * nifticlib. 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and
+ * float32 are kept; int8 becomes int16; int32, uint32, int64, uint64 and float64 become float32
+ * (rounded to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope
+ * other than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's
+ * real values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform
+ * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
+ * the file's units. MetaImage and VTK .vti are not supported (no small maintained library). The header's sizes are checked against the file before the voxels are read. */
+UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
+                                               umbra_volume *out);
 
 typedef struct umbra_raw_desc {
     size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */
@@ -58,9 +70,34 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
  * lines "resolution N" (default 256) and "range LO HI" (finite, LO < HI) before the first point,
  * then one control point "value r g b a" per line, values ascending (equal values make a step):
  * in [0,1] of the volume's normalised range, or with a range, data values in [LO, HI].
- * UMBRA_ERROR_FORMAT names the line and value for anything else. */
+ * UMBRA_ERROR_FORMAT names the line and value for anything else. A path ending in .json is read
+ * as a ParaView preset with umbra_transfer_function_load_paraview's defaults. */
 UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                                     umbra_transfer_function *out);
+
+/* Options for ParaView presets; umbra_paraview_options_init sets the defaults. */
+typedef struct umbra_paraview_options {
+    size_t struct_size;      /* sizeof(umbra_paraview_options); set by umbra_paraview_options_init */
+    const char *preset;      /* the "Name" to pick in a file of several; NULL (default): the first */
+    uint32_t resolution;     /* table entries, 2..65536 (default 1024) */
+    int range_given;         /* 0 (default): the table spans the preset's own x range */
+    double range_min, range_max; /* with range_given: the data values the table spans */
+} umbra_paraview_options;
+
+UMBRA_API void umbra_paraview_options_init(umbra_paraview_options *options);
+
+/* Reads a ParaView JSON colour-map preset (RGBPoints, Points with midpoint and sharpness,
+ * ColorSpace RGB / Lab / CIELAB / Diverging / Step; see the README) and evaluates it into a table
+ * of options->resolution entries over a data range: the preset's own (smallest to largest x of its
+ * points) or options' range, and gives the table that data range
+ * (umbra_transfer_function_set_range), so renderers place it over each volume's values in data
+ * units (e.g. Hounsfield units). options may be NULL (defaults). range, if not NULL, receives
+ * the data range the table spans. Malformed files are UMBRA_ERROR_FORMAT naming the key and
+ * point; unsupported colour spaces UMBRA_ERROR_UNSUPPORTED. */
+UMBRA_API umbra_status umbra_transfer_function_load_paraview(umbra_context ctx, const char *path,
+                                                             const umbra_paraview_options *options,
+                                                             umbra_transfer_function *out,
+                                                             double range[2]);
 
 /* ---- images ------------------------------------------------------------------------------------
  * The format follows the extension: .png is written as 8-bit sRGB-encoded RGBA (colour

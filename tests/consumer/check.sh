@@ -68,7 +68,7 @@ done
 
 echo "== a program on umbra::umbra alone loads no I/O library"
 deps=$(ldd "$work/fp/consumer_c")
-if grep -Eqi 'OpenImageIO|teem|avcodec|avformat|gdal|opencv|dcmtk|openvdb' <<<"$deps"; then
+if grep -Eqi 'OpenImageIO|teem|nifti|znz|cjson|avcodec|avformat|gdal|opencv|dcmtk|openvdb' <<<"$deps"; then
   echo "$deps" >&2
   fail "consumer_c loads an I/O dependency"
 fi
