@@ -35,7 +35,13 @@ typedef enum umbra_projection {
     UMBRA_ORTHOGRAPHIC = 1
 } umbra_projection;
 
-/* A look-at camera in world space (the volume's box is centred on the origin). */
+/* Bound on the magnitude of every world coordinate the renderer is given (camera eye and target,
+ * point-light position): within it, differences and squared lengths stay finite in float.
+ * Setters refuse points beyond it with UMBRA_ERROR_INVALID_ARGUMENT naming them. */
+#define UMBRA_MAX_COORDINATE 1e18f
+
+/* A look-at camera in world space (the volume's box is centred on the origin). eye and target
+ * lie within +-UMBRA_MAX_COORDINATE; up is any finite vector not parallel to the view. */
 typedef struct umbra_camera {
     umbra_projection projection;
     float eye[3];
@@ -56,8 +62,10 @@ typedef enum umbra_light_type {
 
 typedef struct umbra_light {
     umbra_light_type type;
-    float position[3];   /* point light, world space; may lie inside the volume */
-    float direction[3];  /* directional light: the direction light travels in (need not be unit) */
+    float position[3];   /* point light, world space, within +-UMBRA_MAX_COORDINATE; may lie
+                            inside the volume */
+    float direction[3];  /* directional light: the direction light travels in (need not be unit;
+                            any finite non-zero vector) */
     float color[3];      /* RGB intensity, each >= 0 */
 } umbra_light;
 
@@ -65,6 +73,13 @@ typedef enum umbra_transmission {
     UMBRA_TRANSMISSION_GREY = 0,    /* t = 0: every channel attenuated by the opacity alone */
     UMBRA_TRANSMISSION_COLORED = 1  /* t = RGB of the light transfer function */
 } umbra_transmission;
+
+/* Bound on the samples one ray may take: the box diagonal over the step, for view rays (step),
+ * shadow rays (reference_step) and light rays (map_step, slice_distance / (subsamples + 1)). A
+ * render (or query) whose volume and steps would exceed it fails with
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the count and this limit, before any work: such a volume
+ * is too anisotropic or too large for the step (raise the step, or resample the volume). */
+#define UMBRA_MAX_RAY_SAMPLES 1048576u
 
 typedef struct umbra_render_desc {
     size_t struct_size;      /* sizeof(umbra_render_desc); set by umbra_render_desc_init */
