@@ -9,7 +9,9 @@
  *  - row 6: a float volume holding +-3e38 maps its values (not all to 0), and a constant volume
  *    above 2^24 gets a non-empty value range;
  *  - row 7: a volume whose world extent is beyond UMBRA_MAX_EXTENT (or infinite) is refused at
- *    creation, from the API and from a NRRD file, naming the extent. */
+ *    creation, from the API and from a NRRD file, naming the extent.
+ *
+ * Usage: test_hardening [filter] (a cmocka test-name glob). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -333,7 +335,7 @@ static void test_nrrd_spacing_1e20_is_refused_at_load(void **state)
     remove(path);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_spacing_1e6_view_rays_are_refused_not_run_for_minutes),
@@ -348,5 +350,7 @@ int main(void)
         cmocka_unit_test(test_volume_extent_beyond_limit_is_refused),
         cmocka_unit_test(test_nrrd_spacing_1e20_is_refused_at_load),
     };
+    if (argc > 1)
+        cmocka_set_test_filter(argv[1]);
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
