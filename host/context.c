@@ -5,7 +5,12 @@
  * use_environment, $UMBRA_DEVICE ("P:D" indices or a name substring); else the first GPU, else
  * the first device of any type. PoCL needs a writable kernel cache: unless $POCL_CACHE_DIR is set,
  * it is pointed at desc->cache_dir or a directory under $TMPDIR (or /tmp) before OpenCL starts,
- * so a user whose HOME is read-only still gets a working context. */
+ * so a user whose HOME is read-only still gets a working context.
+ *
+ * Threads: OpenCL start-up is process-wide and PoCL's lazy device set-up is not thread-safe (two
+ * threads creating the first contexts crashed in clGetDeviceInfo), and setenv races with every
+ * getenv: umbra_context_create does device discovery and creation under one process-wide mutex,
+ * the only mutable global in umbra, which exists because the state it guards is process-wide. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -17,6 +22,8 @@
 #include <unistd.h>
 
 #include "internal.h"
+
+static pthread_mutex_t discovery_lock = PTHREAD_MUTEX_INITIALIZER;
 
 struct umbra__program {
     umbra__program *next;
@@ -191,7 +198,19 @@ static umbra_status context_alloc(const umbra_context_desc *desc, umbra_context 
         report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: out of host memory");
         return UMBRA_ERROR_OUT_OF_MEMORY;
     }
-    ctx->refs = 1;
+    if (pthread_mutex_init(&ctx->program_lock, NULL) != 0) {
+        free(ctx);
+        report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: pthread_mutex_init failed");
+        return UMBRA_ERROR_OUT_OF_MEMORY;
+    }
+    if (pthread_mutex_init(&ctx->error_lock, NULL) != 0) {
+        pthread_mutex_destroy(&ctx->program_lock);
+        free(ctx);
+        report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: pthread_mutex_init failed");
+        return UMBRA_ERROR_OUT_OF_MEMORY;
+    }
+    atomic_init(&ctx->refs, 1);
+    atomic_init(&ctx->next_id, 0);
     if (desc) {
         ctx->callback = desc->error_callback;
         ctx->callback_user = desc->error_user;
@@ -230,12 +249,12 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
         umbra_context_desc_init(&defaults);
         desc = &defaults;
     }
-    prepare_pocl_cache(desc);
-
     umbra_context ctx = NULL;
     umbra_status st = context_alloc(desc, &ctx);
     if (st != UMBRA_SUCCESS)
         return st;
+    pthread_mutex_lock(&discovery_lock);
+    prepare_pocl_cache(desc);
     st = pick_device(desc, &ctx->platform, &ctx->device);
     if (st != UMBRA_SUCCESS)
         goto fail;
@@ -245,9 +264,11 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
     ctx->queue = clCreateCommandQueue(ctx->cl_ctx, ctx->device, CL_QUEUE_PROFILING_ENABLE, &err);
     UMBRA_CL_CHECK(err, "clCreateCommandQueue");
     describe_device(ctx, desc);
+    pthread_mutex_unlock(&discovery_lock);
     *out = ctx;
     return UMBRA_SUCCESS;
 fail:
+    pthread_mutex_unlock(&discovery_lock);
     umbra_context_release(ctx);
     return st;
 }
@@ -293,12 +314,12 @@ umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device
 void umbra_context_retain(umbra_context ctx)
 {
     if (ctx)
-        ++ctx->refs;
+        atomic_fetch_add(&ctx->refs, 1);
 }
 
 void umbra_context_release(umbra_context ctx)
 {
-    if (!ctx || --ctx->refs > 0)
+    if (!ctx || atomic_fetch_sub(&ctx->refs, 1) > 1)
         return;
     for (umbra__program *p = ctx->programs; p;) {
         umbra__program *next = p->next;
@@ -311,6 +332,8 @@ void umbra_context_release(umbra_context ctx)
         clReleaseCommandQueue(ctx->queue);
     if (ctx->cl_ctx)
         clReleaseContext(ctx->cl_ctx);
+    pthread_mutex_destroy(&ctx->program_lock);
+    pthread_mutex_destroy(&ctx->error_lock);
     free(ctx);
 }
 
@@ -323,7 +346,7 @@ cl_context umbra_context_cl_context(umbra_context ctx) { return ctx ? ctx->cl_ct
 cl_device_id umbra_context_cl_device(umbra_context ctx) { return ctx ? ctx->device : NULL; }
 cl_command_queue umbra_context_cl_queue(umbra_context ctx) { return ctx ? ctx->queue : NULL; }
 
-uint64_t umbra__next_id(umbra_context ctx) { return ++ctx->next_id; }
+uint64_t umbra__next_id(umbra_context ctx) { return atomic_fetch_add(&ctx->next_id, 1) + 1; }
 
 /* ---- programs ------------------------------------------------------------------------------- */
 
@@ -345,8 +368,22 @@ static char *program_key(const char *const *files, size_t nfiles, const char *op
     return key;
 }
 
+/* Two renderers on one context may ask for the same program at once: the lookup, the build and
+ * the insertion happen under the cache's lock, so each program is built once. */
+static umbra_status program_get_locked(umbra_context ctx, const char *const *files, size_t nfiles,
+                                       const char *options, cl_program *out);
+
 umbra_status umbra__program_get(umbra_context ctx, const char *const *files, size_t nfiles,
                                 const char *options, cl_program *out)
+{
+    pthread_mutex_lock(&ctx->program_lock);
+    umbra_status st = program_get_locked(ctx, files, nfiles, options, out);
+    pthread_mutex_unlock(&ctx->program_lock);
+    return st;
+}
+
+static umbra_status program_get_locked(umbra_context ctx, const char *const *files, size_t nfiles,
+                                       const char *options, cl_program *out)
 {
     umbra_status st = UMBRA_SUCCESS;
     const char *sources[16];

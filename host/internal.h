@@ -5,7 +5,9 @@
 #ifndef UMBRA_HOST_INTERNAL_H
 #define UMBRA_HOST_INTERNAL_H
 
+#include <pthread.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -57,8 +59,18 @@ const char *umbra__cl_error_name(cl_int err);
 
 typedef struct umbra__program umbra__program;
 
+/* The object structs use C11 atomics, which C++17 lacks: C++ files (host/image.cpp) see only
+ * the functions. */
+#ifndef __cplusplus
+/* Threads: a context may be shared by objects used on different threads (include/umbra/
+ * context.h), so its reference count and ids are atomic and mutexes guard what they share: the
+ * program cache and the error state (one mutex each: a failing build records its error while
+ * holding the cache). Objects' reference counts are atomic too; the rest of an object is used by
+ * one thread at a time. */
 struct umbra_context_t {
-    int refs;
+    atomic_int refs;
+    pthread_mutex_t program_lock;       /* guards programs */
+    pthread_mutex_t error_lock;         /* guards first_error, the messages and the callback */
     cl_platform_id platform;
     cl_context cl_ctx;
     cl_device_id device;
@@ -73,8 +85,9 @@ struct umbra_context_t {
     char last_message[UMBRA_MESSAGE_MAX];
     umbra_error_callback callback;
     void *callback_user;
-    uint64_t next_id;                   /* source of volume / transfer-function ids */
+    atomic_uint_least64_t next_id;      /* source of volume / transfer-function ids */
 };
+#endif
 
 /* Returns (building on first use, then from the context's cache) the program made of the named
  * embedded kernel files, concatenated in order after the shared struct header, built with the
@@ -101,8 +114,9 @@ double umbra__now_ms(void);
 
 /* ---- volume ---------------------------------------------------------------------------------- */
 
+#ifndef __cplusplus
 struct umbra_volume_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     uint32_t dims[3];
     float spacing[3];
@@ -117,17 +131,20 @@ struct umbra_volume_t {
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
 };
+#endif
 
 /* ---- transfer function ---------------------------------------------------------------------- */
 
+#ifndef __cplusplus
 struct umbra_transfer_function_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     uint32_t count;
     float *rgba;             /* host copy, 4*count */
     cl_mem buffer;           /* device copy, float4 per entry */
     uint64_t id;             /* unique per table */
 };
+#endif
 
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);

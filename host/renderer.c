@@ -156,7 +156,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
     umbra_renderer r = calloc(1, sizeof *r);
     if (!r)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_create: out of memory");
-    r->refs = 1;
+    atomic_init(&r->refs, 1);
     r->ctx = ctx;
     umbra_context_retain(ctx);
     umbra_render_desc_init(&r->opts);
@@ -174,7 +174,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
 void umbra_renderer_retain(umbra_renderer r)
 {
     if (r)
-        ++r->refs;
+        atomic_fetch_add(&r->refs, 1);
 }
 
 static void release_mem(cl_mem *m)
@@ -204,7 +204,7 @@ static void drop_technique(umbra_renderer r)
 
 void umbra_renderer_release(umbra_renderer r)
 {
-    if (!r || --r->refs > 0)
+    if (!r || atomic_fetch_sub(&r->refs, 1) > 1)
         return;
     drop_technique(r);
     release_kernels(r);

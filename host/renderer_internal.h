@@ -51,7 +51,7 @@ typedef struct umbra__light_key {
 } umbra__light_key;
 
 struct umbra_renderer_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     umbra_volume volume;
     umbra_transfer_function tf, light_tf;   /* light_tf NULL: the view tf */

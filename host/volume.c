@@ -170,7 +170,7 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     const size_t count = (size_t)desc->dims[0] * desc->dims[1] * desc->dims[2];
     if (!v)
         goto oom;
-    v->refs = 1;
+    atomic_init(&v->refs, 1);
     v->ctx = ctx;
     umbra_context_retain(ctx);
     memcpy(v->dims, desc->dims, sizeof v->dims);
@@ -278,12 +278,12 @@ umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
 void umbra_volume_retain(umbra_volume v)
 {
     if (v)
-        ++v->refs;
+        atomic_fetch_add(&v->refs, 1);
 }
 
 void umbra_volume_release(umbra_volume v)
 {
-    if (!v || --v->refs > 0)
+    if (!v || atomic_fetch_sub(&v->refs, 1) > 1)
         return;
     if (v->data)
         clReleaseMemObject(v->data);

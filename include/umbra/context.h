@@ -2,7 +2,17 @@
  *
  * A context owns the OpenCL context, device and queue (or retains the application's), the cache of
  * built programs, and the error state. Every other umbra object belongs to one context and keeps
- * it alive. A context may be used from one thread at a time; two contexts never interfere. */
+ * it alive.
+ *
+ * Threads. Contexts may be created, used and released on any threads at once (device discovery
+ * is serialised inside umbra_context_create, as OpenCL start-up is process-wide); two contexts
+ * never interfere. Objects of one context may also be used on different threads at once (two
+ * renderers rendering on two threads share the program cache, the queue and the error state
+ * safely; reference counts are atomic), but each object (a renderer, a volume being created or
+ * released) by one thread at a time. The error state is then shared: umbra_context_take_error
+ * and umbra_context_last_message return whichever thread's error came first or last, and their
+ * message pointers may be overwritten by the next error on any thread; for per-call errors across
+ * threads, use the callback, which runs on the thread whose call failed. */
 #ifndef UMBRA_CONTEXT_H
 #define UMBRA_CONTEXT_H
 
