@@ -19,6 +19,7 @@ const char *umbra_status_to_string(umbra_status status)
     case UMBRA_ERROR_FORMAT: return "UMBRA_ERROR_FORMAT";
     case UMBRA_ERROR_UNSUPPORTED: return "UMBRA_ERROR_UNSUPPORTED";
     case UMBRA_ERROR_NO_DEVICE: return "UMBRA_ERROR_NO_DEVICE";
+    case UMBRA_ERROR_CANCELLED: return "UMBRA_ERROR_CANCELLED";
     }
     return "UMBRA_ERROR_UNKNOWN";
 }

@@ -83,7 +83,35 @@ struct umbra_renderer_t {
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
 
     umbra_render_stats stats;
+
+    umbra_progress_callback progress;        /* optional: umbra_renderer_set_progress */
+    void *progress_user;
+    double progress_lo, progress_hi;         /* the current phase's share of the call */
+    double progress_last;                    /* last fraction reported (kept non-decreasing) */
+    double band_samples;                     /* test knob: samples per band, 0: the default */
 };
+
+/* Samples per band of a banded launch (umbra__run_2d): about 0.1-1 s of PoCL on two cores, a
+ * small fraction of a second on a GPU; bands hold at least UMBRA__BAND_MIN_ITEMS work-items so
+ * a GPU stays busy. */
+#define UMBRA__BAND_SAMPLES 33554432.0
+#define UMBRA__BAND_MIN_ITEMS 16384.0
+
+/* An upper bound on the samples one ray with the given step (in voxels) takes in the volume's
+ * box: its diagonal over the step. */
+double umbra__ray_samples(umbra_renderer r, float step_voxels);
+
+/* Reports that fraction (0..1) of the current phase is done to the progress callback, if any.
+ * Returns UMBRA_ERROR_CANCELLED (recorded with fn's name) if the callback asks to stop. */
+umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn);
+
+/* Runs a 2D kernel over global[0] x global[1] work-items (rounded up to local, NULL: 8 x 8) and
+ * waits, adding its device time to *ms. With a progress callback the range is split into bands
+ * of rows, each one launch with a global offset, of about UMBRA__BAND_SAMPLES samples at
+ * cost samples per work-item, one band in flight while the previous one is waited for and
+ * reported; the callback can cancel between bands. The kernel must index by global id. */
+umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2],
+                           const size_t *local, double cost, double *ms, const char *fn);
 
 /* The light transfer function in effect (the view one unless a light one was set). */
 umbra_transfer_function umbra__light_tf(umbra_renderer r);

@@ -208,6 +208,20 @@ typedef struct umbra_render_stats {
 
 umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
 
+/* Progress and cancellation of long calls. Called on the calling thread during
+ * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow,
+ * between pieces of device work (bands of rows of the image or of the shadow map, groups of
+ * convolution slices), with the fraction of the call's work done: in [0, 1], non-decreasing,
+ * and exactly 1 in the last call of a call that succeeds. Return nonzero to cancel: the call
+ * waits for the piece in flight (bands are sized to about 2^25 samples), then returns
+ * UMBRA_ERROR_CANCELLED; the renderer stays usable (the next render rebuilds what was cut
+ * short). The callback must not call this renderer. */
+typedef int (*umbra_progress_callback)(void *user, float fraction);
+
+/* Installs (or with NULL removes) the progress callback; user is passed to it (borrowed). With a
+ * callback, long launches are split into bands, which changes no pixel. */
+umbra_status umbra_renderer_set_progress(umbra_renderer r, umbra_progress_callback cb, void *user);
+
 #ifdef __cplusplus
 }
 #endif
