@@ -770,9 +770,9 @@ umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2]
     size_t rows = gy;
     if (r->progress) {
         double budget = r->band_samples > 0.0 ? r->band_samples : UMBRA__BAND_SAMPLES;
-        double want = fmax(budget / ((double)gx * fmax(cost, 1.0)), UMBRA__BAND_MIN_ITEMS / (double)gx);
-        if (r->band_samples > 0.0)
-            want = budget / ((double)gx * fmax(cost, 1.0));
+        double want = budget / ((double)gx * fmax(cost, 1.0));
+        if (!(r->band_samples > 0.0)) /* the tests' knob may go below the minimum */
+            want = fmax(want, UMBRA__BAND_MIN_ITEMS / (double)gx);
         if (want < (double)gy)
             rows = round_up(want < 1.0 ? 1 : (size_t)want, local[1]);
     }
@@ -859,9 +859,9 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     umbra__frame_update_light(r);
     float light_step = r->tech->light_step ? r->tech->light_step(&r->shadow) : r->shadow.reference_step;
     umbra_status st = UMBRA_SUCCESS;
+    const char *what = r->tech->id == UMBRA_SHADOW_REFERENCE ? "shadow" : "light";
     if (r->tech->id != UMBRA_SHADOW_NONE &&
-        (st = check_ray_samples(r, light_step, r->tech->id == UMBRA_SHADOW_REFERENCE ? "shadow" : "light",
-                                "umbra_renderer_render")) != UMBRA_SUCCESS)
+        (st = check_ray_samples(r, light_step, what, "umbra_renderer_render")) != UMBRA_SUCCESS)
         return st;
     st = umbra__light_tables(r, light_step);
     if (st != UMBRA_SUCCESS)
