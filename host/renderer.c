@@ -710,108 +710,6 @@ fail:
     return st;
 }
 
-/* ---- progress and cancellation ------------------------------------------------------------------------ */
-
-umbra_status umbra_renderer_set_progress(umbra_renderer r, umbra_progress_callback cb, void *user)
-{
-    CHECK_R();
-    r->progress = cb;
-    r->progress_user = user;
-    return UMBRA_SUCCESS;
-}
-
-/* A call's work is split into phases (the shadow build, then the frame), each a share
- * [lo, hi] of the fraction reported. */
-static void progress_phase(umbra_renderer r, double lo, double hi)
-{
-    r->progress_lo = lo;
-    r->progress_hi = hi;
-}
-
-static void progress_begin(umbra_renderer r)
-{
-    r->progress_last = 0.0;
-    progress_phase(r, 0.0, 1.0);
-}
-
-umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn)
-{
-    if (!r->progress)
-        return UMBRA_SUCCESS;
-    double f = r->progress_lo + (r->progress_hi - r->progress_lo) * fraction;
-    f = f > 1.0 ? 1.0 : f;
-    f = f < r->progress_last ? r->progress_last : f; /* a repeated pass does not go back */
-    r->progress_last = f;
-    if (r->progress(r->progress_user, (float)f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_CANCELLED,
-                           "%s: cancelled by the progress callback at %.1f%%", fn, 100.0 * f);
-    return UMBRA_SUCCESS;
-}
-
-/* The last report of a call that succeeded: exactly 1 (the work is done; a request to stop is
- * too late to matter). */
-static void progress_end(umbra_renderer r)
-{
-    if (r->progress && r->progress_last < 1.0) {
-        r->progress_last = 1.0;
-        (void)r->progress(r->progress_user, 1.0f);
-    }
-}
-
-static size_t round_up(size_t x, size_t m) { return (x + m - 1) / m * m; }
-
-umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2],
-                           const size_t *local_in, double cost, double *ms, const char *fn)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    const size_t local[2] = {local_in ? local_in[0] : 8, local_in ? local_in[1] : 8};
-    const size_t gx = round_up(global[0], local[0]), gy = round_up(global[1], local[1]);
-    size_t rows = gy;
-    if (r->progress) {
-        double budget = r->band_samples > 0.0 ? r->band_samples : UMBRA__BAND_SAMPLES;
-        double want = budget / ((double)gx * fmax(cost, 1.0));
-        if (!(r->band_samples > 0.0)) /* the tests' knob may go below the minimum */
-            want = fmax(want, UMBRA__BAND_MIN_ITEMS / (double)gx);
-        if (want < (double)gy)
-            rows = round_up(want < 1.0 ? 1 : (size_t)want, local[1]);
-    }
-    const size_t bands = (gy + rows - 1) / rows;
-    cl_event ev[2] = {NULL, NULL};
-    double t0 = umbra__now_ms(), device = 0.0;
-    int device_ok = 1;
-    /* Band b + 1 is queued before band b is waited for, so the device never idles between bands. */
-    for (size_t b = 0; b <= bands; ++b) {
-        if (b < bands) {
-            const size_t offset[2] = {0, b * rows};
-            const size_t size[2] = {gx, rows < gy - b * rows ? rows : gy - b * rows};
-            UMBRA_CL(clEnqueueNDRangeKernel(ctx->queue, k, 2, offset, size, local, 0, NULL,
-                                            &ev[b % 2]));
-            UMBRA_CL(clFlush(ctx->queue));
-        }
-        if (b > 0) {
-            cl_event *e = &ev[(b - 1) % 2];
-            UMBRA_CL(clWaitForEvents(1, e));
-            double t = umbra__event_ms(*e);
-            device += t;
-            device_ok = device_ok && t >= 0.0;
-            clReleaseEvent(*e);
-            *e = NULL;
-            if ((st = umbra__progress(r, (double)b / (double)bands, fn)) != UMBRA_SUCCESS)
-                goto fail;
-        }
-    }
-    *ms += device_ok ? device : umbra__now_ms() - t0;
-fail:
-    /* A cancelled call returns with nothing of it left running on the device. */
-    for (int i = 0; i < 2; ++i)
-        if (ev[i]) {
-            clWaitForEvents(1, &ev[i]);
-            clReleaseEvent(ev[i]);
-        }
-    return st;
-}
-
 /* ---- the frame ---------------------------------------------------------------------------------------- */
 
 static umbra_status check_ready(umbra_renderer r, const char *fn)
@@ -879,7 +777,7 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
         return UMBRA_SUCCESS;
     r->built_valid = 0;
-    progress_phase(r, 0.0, build_share);
+    umbra__progress_phase(r, 0.0, build_share);
     r->shadow_params.step = light_step * umbra__voxel_world(r);
     st = umbra__upload_params(r);
     if (st == UMBRA_SUCCESS && r->tech->build)
@@ -922,7 +820,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_status st = check_ready(r, fn);
     if (st != UMBRA_SUCCESS)
         return st;
-    progress_begin(r);
+    umbra__progress_begin(r);
     /* The convolution technique's slices set its view sampling (bounded with its light step). */
     if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
         return st;
@@ -930,7 +828,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     st = prepare_shadow(r, 0.5);
     if (st != UMBRA_SUCCESS)
         return st;
-    progress_phase(r, r->progress_last, 1.0);
+    umbra__progress_phase(r, r->progress_last, 1.0);
     st = tables(r, r->tf, r->opts.step, r->view_tf_key, &r->view_tf_buf, &r->view_bricks_buf,
                 &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
@@ -1021,7 +919,7 @@ umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t he
     if (st != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->out_buf, CL_TRUE, 0, bytes, rgba, 0, NULL, NULL));
-    progress_end(r);
+    umbra__progress_end(r);
 fail:
     return st;
 }
@@ -1054,7 +952,7 @@ umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width
         UMBRA_CL(clFinish(ctx->queue));
     clReleaseMemObject(rgba);
     if (st == UMBRA_SUCCESS)
-        progress_end(r);
+        umbra__progress_end(r);
     return st;
 fail:
     return st;
@@ -1078,7 +976,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique '%s' has no per-point shadow lookup", fn,
                            umbra_shadow_technique_name(r->tech->id));
-    progress_begin(r);
+    umbra__progress_begin(r);
     if ((st = prepare_shadow(r, 1.0)) != UMBRA_SUCCESS)
         return st;
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
@@ -1103,7 +1001,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     if ((st = umbra__enqueue(ctx, r->query_kernel, 1, &global, NULL, NULL)) != UMBRA_SUCCESS)
         goto fail;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
-    progress_end(r);
+    umbra__progress_end(r);
 fail:
     release_mem(&in);
     release_mem(&outb);

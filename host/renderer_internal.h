@@ -101,6 +101,13 @@ struct umbra_renderer_t {
  * box: its diagonal over the step. */
 double umbra__ray_samples(umbra_renderer r, float step_voxels);
 
+/* A call's work is split into phases (the shadow build, then the frame), each a share [lo, hi]
+ * of the fraction reported: begin starts a call at 0 with the phase [0, 1]; end makes the last
+ * report of a call that succeeded exactly 1 (a request to stop then comes too late to matter). */
+void umbra__progress_begin(umbra_renderer r);
+void umbra__progress_phase(umbra_renderer r, double lo, double hi);
+void umbra__progress_end(umbra_renderer r);
+
 /* Reports that fraction (0..1) of the current phase is done to the progress callback, if any.
  * Returns UMBRA_ERROR_CANCELLED (recorded with fn's name) if the callback asks to stop. */
 umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn);
