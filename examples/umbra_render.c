@@ -1,11 +1,16 @@
 /* umbra-render: the command-line front end. Renders a built-in scene or a volume file with a
  * chosen shadow technique into a PNG or EXR and prints each stage's time to stderr.
- * Run with --help for the options. Exit status: 0 on success, 1 on bad input, 2 on a failure. */
+ * Run with --help for the options. Exit status: 0 on success, 1 on bad input, 2 on a failure,
+ * 130 when interrupted (Ctrl-C stops the render between two pieces of device work). */
+#define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "umbra/io.h"
 
@@ -45,6 +50,7 @@ static void usage(FILE *f)
         "  --jitter              jitter ray starts (seeded by --seed)\n"
         "  --seed N              seed for jitter and stochastic maps\n"
         "  --device SPEC         OpenCL device: P:D indices or a name substring\n"
+        "  --progress | --no-progress   progress line on stderr (default: when it is a terminal)\n"
         "  --reference-step S    reference: shadow-ray step in voxels (default 0.25)\n"
         "  --map-size N --map-step S --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
         "  --block-size K --prefilter 1|5 --no-lookup-table      light-space map parameters\n"
@@ -94,7 +100,43 @@ static int parse_size(const char *s, uint32_t *w, uint32_t *h)
 static void on_error(void *user, umbra_status st, const char *msg)
 {
     (void)user;
+    if (st == UMBRA_ERROR_CANCELLED)
+        return; /* reported as "interrupted" */
     fprintf(stderr, "umbra-render: %s: %s\n", umbra_status_to_string(st), msg);
+}
+
+/* Ctrl-C sets the flag; the progress callback, called between pieces of device work, reads it
+ * and cancels the render, so the program still cleans up and exits with a message. */
+static volatile sig_atomic_t interrupted;
+
+static void on_sigint(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+typedef struct progress_state {
+    int show;          /* print a progress line */
+    double start_ms;   /* a line only once a render has run this long: short ones stay quiet */
+    int shown;
+} progress_state;
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int on_progress(void *user, float fraction)
+{
+    progress_state *p = user;
+    if (p->show && (p->shown || now_ms() - p->start_ms > 500.0)) {
+        fprintf(stderr, "\rrendering: %5.1f%%", 100.0 * fraction);
+        fflush(stderr);
+        p->shown = 1;
+    }
+    return interrupted != 0;
 }
 
 #define BAD(...)                                                                               \
@@ -116,6 +158,7 @@ typedef struct options {
     float tf_range[2];
     int have_tf_range;
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
+    int progress;                                                   /* -1: when a terminal */
     uint32_t seed;
     umbra_shadow_desc shadow;
 } options;
@@ -127,7 +170,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->out = "umbra.png";
     o->width = o->height = 512;
     o->fov = 30.0f;
-    o->shading = o->ground = o->colored = -1;
+    o->shading = o->ground = o->colored = o->progress = -1;
     umbra_raw_desc_init(&o->raw_desc);
     umbra_shadow_desc_init(&o->shadow);
     for (int i = 1; i < argc; ++i) {
@@ -202,6 +245,8 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--jitter")) o->jitter = 1;
         else if (FLAG("--seed")) { NEED(); if (!parse_uint(v, &o->seed)) BAD("--seed '%s' is not a whole number", v); o->have_seed = 1; o->shadow.seed = o->seed; }
         else if (FLAG("--device")) { NEED(); o->device = v; }
+        else if (FLAG("--progress")) o->progress = 1;
+        else if (FLAG("--no-progress")) o->progress = 0;
         else if (FLAG("--reference-step")) { NEED(); if (!parse_floats(v, &o->shadow.reference_step, 1)) BAD("--reference-step '%s' is not a number", v); }
         else if (FLAG("--map-size")) { NEED(); if (!parse_uint(v, &o->shadow.map_size)) BAD("--map-size '%s' is not a whole number", v); }
         else if (FLAG("--map-step")) { NEED(); if (!parse_floats(v, &o->shadow.map_step, 1)) BAD("--map-step '%s' is not a number", v); }
@@ -382,7 +427,21 @@ static int run(const options *o, session *s)
         fprintf(stderr, "umbra-render: out of memory for a %ux%u image\n", o->width, o->height);
         return 2;
     }
-    if (umbra_renderer_render(r, o->width, o->height, s->pixels) != UMBRA_SUCCESS)
+    progress_state prog = {o->progress < 0 ? isatty(STDERR_FILENO) : o->progress, now_ms(), 0};
+    umbra_renderer_set_progress(r, on_progress, &prog);
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    umbra_status rst = umbra_renderer_render(r, o->width, o->height, s->pixels);
+    if (prog.shown)
+        fputc('\n', stderr);
+    if (rst == UMBRA_ERROR_CANCELLED) {
+        fprintf(stderr, "umbra-render: interrupted\n");
+        return 130;
+    }
+    if (rst != UMBRA_SUCCESS)
         return 2;
     umbra_render_stats stats;
     umbra_renderer_get_stats(r, &stats);

@@ -11,7 +11,12 @@
  * what the previous one wrote; a blocking read follows the kernel it reads). On an application's
  * out-of-order queue that order does not hold, so umbra makes its own in-order queue on the
  * application's context and device and enqueues there (include/umbra/context.h, "The OpenCL
- * contract"). */
+ * contract").
+ *
+ * Threads: OpenCL start-up is process-wide and PoCL's lazy device set-up is not thread-safe (two
+ * threads creating the first contexts crashed in clGetDeviceInfo), and setenv races with every
+ * getenv: umbra_context_create does device discovery and creation under one process-wide mutex,
+ * the only mutable global in umbra, which exists because the state it guards is process-wide. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -23,6 +28,8 @@
 #include <unistd.h>
 
 #include "internal.h"
+
+static pthread_mutex_t discovery_lock = PTHREAD_MUTEX_INITIALIZER;
 
 struct umbra__program {
     umbra__program *next;
@@ -199,7 +206,19 @@ static umbra_status context_alloc(const umbra_context_desc *desc, umbra_context 
         report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: out of host memory");
         return UMBRA_ERROR_OUT_OF_MEMORY;
     }
-    ctx->refs = 1;
+    if (pthread_mutex_init(&ctx->program_lock, NULL) != 0) {
+        free(ctx);
+        report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: pthread_mutex_init failed");
+        return UMBRA_ERROR_OUT_OF_MEMORY;
+    }
+    if (pthread_mutex_init(&ctx->error_lock, NULL) != 0) {
+        pthread_mutex_destroy(&ctx->program_lock);
+        free(ctx);
+        report(desc, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_context_create: pthread_mutex_init failed");
+        return UMBRA_ERROR_OUT_OF_MEMORY;
+    }
+    atomic_init(&ctx->refs, 1);
+    atomic_init(&ctx->next_id, 0);
     if (desc) {
         ctx->callback = desc->error_callback;
         ctx->callback_user = desc->error_user;
@@ -247,12 +266,13 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
     if (!desc_ok(desc, &full))
         return UMBRA_ERROR_INVALID_ARGUMENT;
     desc = &full;
-    prepare_pocl_cache(desc);
 
     umbra_context ctx = NULL;
     umbra_status st = context_alloc(desc, &ctx);
     if (st != UMBRA_SUCCESS)
         return st;
+    pthread_mutex_lock(&discovery_lock);
+    prepare_pocl_cache(desc);
     st = pick_device(desc, &ctx->platform, &ctx->device);
     if (st != UMBRA_SUCCESS)
         goto fail;
@@ -263,9 +283,11 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
     UMBRA_CL_CHECK(err, "clCreateCommandQueue");
     ctx->profiling = 1;
     describe_device(ctx, desc);
+    pthread_mutex_unlock(&discovery_lock);
     *out = ctx;
     return UMBRA_SUCCESS;
 fail:
+    pthread_mutex_unlock(&discovery_lock);
     umbra_context_release(ctx);
     return st;
 }
@@ -337,12 +359,12 @@ fail:
 void umbra_context_retain(umbra_context ctx)
 {
     if (ctx)
-        ++ctx->refs;
+        atomic_fetch_add(&ctx->refs, 1);
 }
 
 void umbra_context_release(umbra_context ctx)
 {
-    if (!ctx || --ctx->refs > 0)
+    if (!ctx || atomic_fetch_sub(&ctx->refs, 1) > 1)
         return;
     for (umbra__program *p = ctx->programs; p;) {
         umbra__program *next = p->next;
@@ -357,6 +379,8 @@ void umbra_context_release(umbra_context ctx)
         clReleaseCommandQueue(ctx->app_queue);
     if (ctx->cl_ctx)
         clReleaseContext(ctx->cl_ctx);
+    pthread_mutex_destroy(&ctx->program_lock);
+    pthread_mutex_destroy(&ctx->error_lock);
     free(ctx);
 }
 
@@ -369,7 +393,7 @@ cl_context umbra_context_cl_context(umbra_context ctx) { return ctx ? ctx->cl_ct
 cl_device_id umbra_context_cl_device(umbra_context ctx) { return ctx ? ctx->device : NULL; }
 cl_command_queue umbra_context_cl_queue(umbra_context ctx) { return ctx ? ctx->queue : NULL; }
 
-uint64_t umbra__next_id(umbra_context ctx) { return ++ctx->next_id; }
+uint64_t umbra__next_id(umbra_context ctx) { return atomic_fetch_add(&ctx->next_id, 1) + 1; }
 
 /* ---- programs ------------------------------------------------------------------------------- */
 
@@ -391,8 +415,22 @@ static char *program_key(const char *const *files, size_t nfiles, const char *op
     return key;
 }
 
+/* Two renderers on one context may ask for the same program at once: the lookup, the build and
+ * the insertion happen under the cache's lock, so each program is built once. */
+static umbra_status program_get_locked(umbra_context ctx, const char *const *files, size_t nfiles,
+                                       const char *options, cl_program *out);
+
 umbra_status umbra__program_get(umbra_context ctx, const char *const *files, size_t nfiles,
                                 const char *options, cl_program *out)
+{
+    pthread_mutex_lock(&ctx->program_lock);
+    umbra_status st = program_get_locked(ctx, files, nfiles, options, out);
+    pthread_mutex_unlock(&ctx->program_lock);
+    return st;
+}
+
+static umbra_status program_get_locked(umbra_context ctx, const char *const *files, size_t nfiles,
+                                       const char *options, cl_program *out)
 {
     umbra_status st = UMBRA_SUCCESS;
     const char *sources[16];

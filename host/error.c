@@ -29,21 +29,28 @@ const char *umbra_status_to_string(umbra_status status)
     case UMBRA_ERROR_FORMAT: return "UMBRA_ERROR_FORMAT";
     case UMBRA_ERROR_UNSUPPORTED: return "UMBRA_ERROR_UNSUPPORTED";
     case UMBRA_ERROR_NO_DEVICE: return "UMBRA_ERROR_NO_DEVICE";
+    case UMBRA_ERROR_CANCELLED: return "UMBRA_ERROR_CANCELLED";
     }
     return "UMBRA_ERROR_UNKNOWN";
 }
 
+/* Under the context's error lock (objects of one context may be used on several threads); the
+ * callback runs outside it, so that it may call back into umbra. */
 static void record(umbra_context ctx, umbra_status status, const char *message)
 {
     if (!ctx)
         return;
+    pthread_mutex_lock(&ctx->error_lock);
     snprintf(ctx->last_message, sizeof ctx->last_message, "%s", message);
     if (ctx->first_error == UMBRA_SUCCESS) {
         ctx->first_error = status;
         snprintf(ctx->first_message, sizeof ctx->first_message, "%s", message);
     }
-    if (ctx->callback)
-        ctx->callback(ctx->callback_user, status, message);
+    umbra_error_callback cb = ctx->callback;
+    void *user = ctx->callback_user;
+    pthread_mutex_unlock(&ctx->error_lock);
+    if (cb)
+        cb(user, status, message);
 }
 
 umbra_status umbra__fail(umbra_context ctx, umbra_status status, const char *fmt, ...)
@@ -108,11 +115,13 @@ umbra_status umbra_context_take_error(umbra_context ctx, const char **message)
             *message = "umbra_context_take_error: ctx is NULL";
         return UMBRA_ERROR_INVALID_ARGUMENT;
     }
+    pthread_mutex_lock(&ctx->error_lock);
     umbra_status st = ctx->first_error;
     /* first_message is only rewritten when the next error is recorded, so it outlives the reset. */
     if (message)
         *message = st == UMBRA_SUCCESS ? none : ctx->first_message;
     ctx->first_error = UMBRA_SUCCESS;
+    pthread_mutex_unlock(&ctx->error_lock);
     return st;
 }
 
@@ -125,6 +134,8 @@ void umbra_context_set_error_callback(umbra_context ctx, umbra_error_callback cb
 {
     if (!ctx)
         return;
+    pthread_mutex_lock(&ctx->error_lock);
     ctx->callback = cb;
     ctx->callback_user = user;
+    pthread_mutex_unlock(&ctx->error_lock);
 }

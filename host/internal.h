@@ -5,7 +5,9 @@
 #ifndef UMBRA_HOST_INTERNAL_H
 #define UMBRA_HOST_INTERNAL_H
 
+#include <pthread.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -57,8 +59,18 @@ const char *umbra__cl_error_name(cl_int err);
 
 typedef struct umbra__program umbra__program;
 
+/* The object structs use C11 atomics, which C++17 lacks: C++ files (host/image.cpp) see only
+ * the functions. */
+#ifndef __cplusplus
+/* Threads: a context may be shared by objects used on different threads (include/umbra/
+ * context.h), so its reference count and ids are atomic and mutexes guard what they share: the
+ * program cache and the error state (one mutex each: a failing build records its error while
+ * holding the cache). Objects' reference counts are atomic too; the rest of an object is used by
+ * one thread at a time. */
 struct umbra_context_t {
-    int refs;
+    atomic_int refs;
+    pthread_mutex_t program_lock;       /* guards programs */
+    pthread_mutex_t error_lock;         /* guards first_error, the messages and the callback */
     cl_platform_id platform;
     cl_context cl_ctx;
     cl_device_id device;
@@ -76,8 +88,9 @@ struct umbra_context_t {
     char last_message[UMBRA_MESSAGE_MAX];
     umbra_error_callback callback;
     void *callback_user;
-    uint64_t next_id;                   /* source of volume / transfer-function ids */
+    atomic_uint_least64_t next_id;      /* source of volume / transfer-function ids */
 };
+#endif
 
 /* Returns (building on first use, then from the context's cache) the program made of the named
  * embedded kernel files, concatenated in order after the shared struct header, built with the
@@ -105,8 +118,9 @@ double umbra__now_ms(void);
 
 /* ---- volume ---------------------------------------------------------------------------------- */
 
+#ifndef __cplusplus
 struct umbra_volume_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     uint32_t dims[3];
     float spacing[3];
@@ -128,6 +142,7 @@ struct umbra_volume_t {
     double axes[9];          /* orthonormal world direction of index axis a in axes[3a..3a+2] */
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
+#endif
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */
@@ -141,8 +156,9 @@ void umbra__volume_point_to_world(umbra_volume v, const float l[3], double out[3
 
 /* ---- transfer function ---------------------------------------------------------------------- */
 
+#ifndef __cplusplus
 struct umbra_transfer_function_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     uint32_t count;
     float *rgba;             /* host copy, 4*count */
@@ -151,6 +167,7 @@ struct umbra_transfer_function_t {
     int range_given;         /* nonzero: the table spans data values range_lo..range_hi */
     float range_lo, range_hi;
 };
+#endif
 
 /* The table tf means for a volume whose normalised range [0,1] stands for data values
  * value_min..value_max: tf itself (retained) when it has no data range, else a new table over

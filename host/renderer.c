@@ -100,12 +100,19 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
     d->cone_angle_degrees = 5.0f;
 }
 
+/* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
+ * (0, -1e20, 0) would get length inf and normalise to zero), never a double. */
+static double len3d(const float v[3])
+{
+    return sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+}
+
 static void normalize3(float v[3])
 {
-    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (l > 0.0f)
+    double l = len3d(v);
+    if (l > 0.0)
         for (int i = 0; i < 3; ++i)
-            v[i] /= l;
+            v[i] = (float)(v[i] / l);
 }
 
 static void cross3(const float a[3], const float b[3], float out[3])
@@ -158,7 +165,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
     umbra_renderer r = calloc(1, sizeof *r);
     if (!r)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_create: out of memory");
-    r->refs = 1;
+    atomic_init(&r->refs, 1);
     r->ctx = ctx;
     umbra_context_retain(ctx);
     umbra_render_desc_init(&r->opts);
@@ -176,7 +183,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
 void umbra_renderer_retain(umbra_renderer r)
 {
     if (r)
-        ++r->refs;
+        atomic_fetch_add(&r->refs, 1);
 }
 
 static void release_mem(cl_mem *m)
@@ -206,7 +213,7 @@ static void drop_technique(umbra_renderer r)
 
 void umbra_renderer_release(umbra_renderer r)
 {
-    if (!r || --r->refs > 0)
+    if (!r || atomic_fetch_sub(&r->refs, 1) > 1)
         return;
     drop_technique(r);
     release_kernels(r);
@@ -278,7 +285,15 @@ static int finite3(const float v[3])
     return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
 }
 
-static float len3(const float v[3]) { return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+/* Finite and within UMBRA_MAX_COORDINATE, so that differences and squared lengths of points
+ * stay finite in the kernels' float arithmetic. */
+static int coordinate3(const float v[3])
+{
+    for (int i = 0; i < 3; ++i)
+        if (!(fabsf(v[i]) <= UMBRA_MAX_COORDINATE))
+            return 0;
+    return 1;
+}
 
 umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *c)
 {
@@ -286,13 +301,23 @@ umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *c)
     CHECK_R();
     if (!c)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: camera is NULL", fn);
-    if (!finite3(c->eye) || !finite3(c->target) || !finite3(c->up))
+    if (!coordinate3(c->eye) || !coordinate3(c->target) || !finite3(c->up))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: eye, target and up must be finite", fn);
-    float f[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
-    float side[3];
-    cross3(f, c->up, side);
-    if (!(len3(f) > 0.0f) || !(len3(side) > 1e-6f * len3(f) * len3(c->up)))
+                           "%s: eye (%g, %g, %g) and target (%g, %g, %g) must be finite and within "
+                           "+-%g, up (%g, %g, %g) finite", fn, c->eye[0], c->eye[1], c->eye[2],
+                           c->target[0], c->target[1], c->target[2], UMBRA_MAX_COORDINATE,
+                           c->up[0], c->up[1], c->up[2]);
+    /* In double: products of large finite floats overflow a float. */
+    double f[3], side[3], u[3] = {c->up[0], c->up[1], c->up[2]};
+    for (int i = 0; i < 3; ++i)
+        f[i] = (double)c->target[i] - c->eye[i];
+    side[0] = f[1] * u[2] - f[2] * u[1];
+    side[1] = f[2] * u[0] - f[0] * u[2];
+    side[2] = f[0] * u[1] - f[1] * u[0];
+    double lf = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    double ls = sqrt(side[0] * side[0] + side[1] * side[1] + side[2] * side[2]);
+    if (!(lf > 0.0) || !(ls > 1e-6 * lf * lu))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: eye (%g, %g, %g) and target (%g, %g, %g) must differ and up "
                            "(%g, %g, %g) must not be parallel to the view direction", fn,
@@ -311,6 +336,8 @@ umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *c)
                            fn, (int)c->projection);
     }
     r->camera = *c;
+    /* Only up's direction matters; a unit up keeps the frame's cross products finite. */
+    normalize3(r->camera.up);
     r->camera_set = 1;
     return UMBRA_SUCCESS;
 }
@@ -324,10 +351,13 @@ umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *l)
     if (l->type != UMBRA_LIGHT_POINT && l->type != UMBRA_LIGHT_DIRECTIONAL)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: light type %d is unknown",
                            fn, (int)l->type);
-    if (!finite3(l->position) || !finite3(l->direction))
+    if (!coordinate3(l->position) || !finite3(l->direction))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: position and direction must be finite", fn);
-    if (l->type == UMBRA_LIGHT_DIRECTIONAL && !(len3(l->direction) > 0.0f))
+                           "%s: position (%g, %g, %g) must be finite and within +-%g, direction "
+                           "(%g, %g, %g) finite", fn, l->position[0], l->position[1],
+                           l->position[2], UMBRA_MAX_COORDINATE, l->direction[0],
+                           l->direction[1], l->direction[2]);
+    if (l->type == UMBRA_LIGHT_DIRECTIONAL && !(len3d(l->direction) > 0.0))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: directional light direction (0, 0, 0) has no direction", fn);
     for (int i = 0; i < 3; ++i)
@@ -733,12 +763,47 @@ static umbra_status check_ready(umbra_renderer r, const char *fn)
     return UMBRA_SUCCESS;
 }
 
+/* Refuses a step that would take more than UMBRA_MAX_RAY_SAMPLES samples along the box's
+ * diagonal (no ray through the box is longer; a shadow or light ray leaves it within that
+ * length too), before any work, so that no input makes a ray loop run for minutes or its
+ * sample count overflow the kernels' int. Computed in double: the volume's extent may be up to
+ * UMBRA_MAX_EXTENT. */
+double umbra__ray_samples(umbra_renderer r, float step_voxels)
+{
+    double diag = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        double e = (double)r->volume->dims[a] * r->volume->spacing[a];
+        diag += e * e;
+    }
+    return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
+}
+
+static umbra_status check_ray_samples(umbra_renderer r, float step_voxels, const char *what,
+                                      const char *fn)
+{
+    double n = umbra__ray_samples(r, step_voxels);
+    double diag = n * step_voxels * umbra__voxel_world(r);
+    if (!(n <= (double)UMBRA_MAX_RAY_SAMPLES))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: a %s ray would take up to %.4g samples (box diagonal %g world "
+                           "units, step %g voxels of %g); the limit is %u (UMBRA_MAX_RAY_SAMPLES): "
+                           "raise the step or resample the volume", fn, what, n, diag,
+                           (double)step_voxels, (double)umbra__voxel_world(r),
+                           UMBRA_MAX_RAY_SAMPLES);
+    return UMBRA_SUCCESS;
+}
+
 /* Light tables and the shadow structure, rebuilt only when the light key changed. */
-static umbra_status prepare_shadow(umbra_renderer r)
+static umbra_status prepare_shadow(umbra_renderer r, double build_share)
 {
     umbra__frame_update_light(r);
     float light_step = r->tech->light_step ? r->tech->light_step(&r->shadow) : r->shadow.reference_step;
-    umbra_status st = umbra__light_tables(r, light_step);
+    umbra_status st = UMBRA_SUCCESS;
+    const char *what = r->tech->id == UMBRA_SHADOW_REFERENCE ? "shadow" : "light";
+    if (r->tech->id != UMBRA_SHADOW_NONE &&
+        (st = check_ray_samples(r, light_step, what, "umbra_renderer_render")) != UMBRA_SUCCESS)
+        return st;
+    st = umbra__light_tables(r, light_step);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__light_key key;
@@ -754,6 +819,7 @@ static umbra_status prepare_shadow(umbra_renderer r)
     if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
         return UMBRA_SUCCESS;
     r->built_valid = 0;
+    umbra__progress_phase(r, 0.0, build_share);
     r->shadow_params.step = light_step * umbra__voxel_world(r);
     st = umbra__upload_params(r);
     if (st == UMBRA_SUCCESS && r->tech->build)
@@ -806,9 +872,15 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
-    st = prepare_shadow(r);
+    umbra__progress_begin(r);
+    /* The convolution technique's slices set its view sampling (bounded with its light step). */
+    if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
+        return st;
+    /* A shadow build, if one is needed, is the first half of the progress reported. */
+    st = prepare_shadow(r, 0.5);
     if (st != UMBRA_SUCCESS)
         return st;
+    umbra__progress_phase(r, r->progress_last, 1.0);
     st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
                 &r->view_bricks_buf, &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
@@ -859,18 +931,19 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     /* A fill copies its pattern at the call: nothing points into this stack frame later. */
     UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0, sizeof zero,
                                  0, NULL, NULL));
-    double t0 = umbra__now_ms();
-    st = umbra__enqueue(ctx, r->render_kernel, 2, global, NULL, &ev);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
     if (r->async) {
+        /* An asynchronous frame is one launch, not waited for: no bands, no progress. */
+        st = umbra__enqueue(ctx, r->render_kernel, 2, global, NULL, &ev);
         r->stats.render_ms = 0.0;
         r->stats.samples = 0;
-        goto fail; /* done: the caller marks the frame's end */
+        goto fail; /* done or failed: the caller marks the frame's end */
     }
-    UMBRA_CL(clWaitForEvents(1, &ev));
-    double ms = umbra__event_ms(ev);
-    r->stats.render_ms = ms >= 0.0 ? ms : umbra__now_ms() - t0;
+    double ms = 0.0;
+    st = umbra__run_2d(r, r->render_kernel, global, NULL, umbra__ray_samples(r, r->opts.step),
+                       &ms, fn);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    r->stats.render_ms = ms;
     cl_ulong samples = 0;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->samples_buf, CL_TRUE, 0, sizeof samples, &samples,
                                  0, NULL, NULL));
@@ -911,6 +984,7 @@ umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t he
     if (st != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->out_buf, CL_TRUE, 0, bytes, rgba, 0, NULL, NULL));
+    umbra__progress_end(r);
 fail:
     return st;
 }
@@ -987,6 +1061,8 @@ umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width
         UMBRA_CL(clFinish(ctx->queue));
 fail:
     clReleaseMemObject(rgba);
+    if (st == UMBRA_SUCCESS)
+        umbra__progress_end(r);
     return st;
 }
 
@@ -1063,7 +1139,8 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique '%s' has no per-point shadow lookup", fn,
                            umbra_shadow_technique_name(r->tech->id));
-    if ((st = prepare_shadow(r)) != UMBRA_SUCCESS)
+    umbra__progress_begin(r);
+    if ((st = prepare_shadow(r, 1.0)) != UMBRA_SUCCESS)
         return st;
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
         return st;
@@ -1097,6 +1174,7 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     if ((st = umbra__enqueue(ctx, r->query_kernel, 1, &global, NULL, NULL)) != UMBRA_SUCCESS)
         goto fail;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
+    umbra__progress_end(r);
 fail:
     free(moved);
     release_mem(&in);

@@ -59,7 +59,7 @@ typedef struct umbra__async {
 } umbra__async;
 
 struct umbra_renderer_t {
-    int refs;
+    atomic_int refs;
     umbra_context ctx;
     umbra_volume volume;
     umbra_transfer_function tf, light_tf;   /* light_tf NULL: the view tf */
@@ -97,7 +97,41 @@ struct umbra_renderer_t {
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
+    umbra_progress_callback progress;        /* optional: umbra_renderer_set_progress */
+    void *progress_user;
+    double progress_lo, progress_hi;         /* the current phase's share of the call */
+    double progress_last;                    /* last fraction reported (kept non-decreasing) */
+    double band_samples;                     /* test knob: samples per band, 0: the default */
 };
+
+/* Samples per band of a banded launch (umbra__run_2d): about 0.1-1 s of PoCL on two cores, a
+ * small fraction of a second on a GPU; bands hold at least UMBRA__BAND_MIN_ITEMS work-items so
+ * a GPU stays busy. */
+#define UMBRA__BAND_SAMPLES 33554432.0
+#define UMBRA__BAND_MIN_ITEMS 16384.0
+
+/* An upper bound on the samples one ray with the given step (in voxels) takes in the volume's
+ * box: its diagonal over the step. */
+double umbra__ray_samples(umbra_renderer r, float step_voxels);
+
+/* A call's work is split into phases (the shadow build, then the frame), each a share [lo, hi]
+ * of the fraction reported: begin starts a call at 0 with the phase [0, 1]; end makes the last
+ * report of a call that succeeded exactly 1 (a request to stop then comes too late to matter). */
+void umbra__progress_begin(umbra_renderer r);
+void umbra__progress_phase(umbra_renderer r, double lo, double hi);
+void umbra__progress_end(umbra_renderer r);
+
+/* Reports that fraction (0..1) of the current phase is done to the progress callback, if any.
+ * Returns UMBRA_ERROR_CANCELLED (recorded with fn's name) if the callback asks to stop. */
+umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn);
+
+/* Runs a 2D kernel over global[0] x global[1] work-items (rounded up to local, NULL: 8 x 8) and
+ * waits, adding its device time to *ms. With a progress callback the range is split into bands
+ * of rows, each one launch with a global offset, of about UMBRA__BAND_SAMPLES samples at
+ * cost samples per work-item, one band in flight while the previous one is waited for and
+ * reported; the callback can cancel between bands. The kernel must index by global id. */
+umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2],
+                           const size_t *local, double cost, double *ms, const char *fn);
 
 /* The view transfer function in effect, over the volume's normalised range (valid once a render
  * or query has begun). */

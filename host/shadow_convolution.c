@@ -358,7 +358,31 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS)
         return st;
     double t0 = umbra__now_ms();
+    /* With a progress callback the slices go in groups of about UMBRA__BAND_SAMPLES samples:
+     * after queueing a group the previous one is waited for and reported, so the device stays
+     * busy and a cancel waits for at most two groups. */
+    const double per_slice = (double)range[0] * range[1] * (G.subsamples + 1u);
+    uint32_t group = UINT32_MAX;
+    if (r->progress) {
+        double budget = r->band_samples > 0.0 ? r->band_samples : UMBRA__BAND_SAMPLES;
+        double g = budget / (per_slice > 1.0 ? per_slice : 1.0);
+        group = g < 1.0 ? 1u : g > (double)n ? (n ? n : 1u) : (uint32_t)g;
+    }
+    cl_event pending = NULL, mark = NULL;
     for (uint32_t i = 0; i < n; ++i) {
+        if (group != UINT32_MAX && i > 0 && i % group == 0) {
+            UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, &mark));
+            UMBRA_CL(clFlush(ctx->queue));
+            if (pending) {
+                UMBRA_CL(clWaitForEvents(1, &pending));
+                clReleaseEvent(pending);
+                pending = NULL;
+                if ((st = umbra__progress(r, (double)(i - group) / n, fn)) != UMBRA_SUCCESS)
+                    goto fail;
+            }
+            pending = mark;
+            mark = NULL;
+        }
         ctl.s[0] = i;
         UMBRA_CL(clSetKernelArg(s->slice, base + 2, sizeof(cl_mem), &s->a[(i + 1) % 2]));
         UMBRA_CL(clSetKernelArg(s->slice, base + 3, sizeof(cl_mem), &s->a[i % 2]));
@@ -407,6 +431,13 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     if (geom_out)
         *geom_out = G;
 fail:
+    /* A cancelled frame returns with nothing of it left running on the device. */
+    if (pending || mark)
+        clFinish(ctx->queue);
+    if (pending)
+        clReleaseEvent(pending);
+    if (mark)
+        clReleaseEvent(mark);
     if (first)
         clReleaseEvent(first);
     if (end)

@@ -35,11 +35,12 @@ typedef struct deep_state {
     cl_mem pool, next, head, counts, counter, fixed, dummy;
     size_t pool_blocks, head_count, counts_count, fixed_bytes;
     size_t block_bytes, node_bytes;
-    size_t used_blocks;
+    size_t used_blocks, asked_blocks;
     uint32_t tiles_per_row, block_size, channels, max_nodes, map_size;
     int fixed_mode, lut_used;
 
     size_t pool_override;           /* test knob: exact pool capacity, 0 = automatic */
+    size_t limit_override;          /* test knob: the block limit, 0 = the device's */
     int allow_growth;
 
     uint64_t builds, build_passes, lut_builds, pool_growths;
@@ -291,6 +292,18 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
     if (!s->pool || (s->pool_override ? s->pool_blocks != want : s->pool_blocks < want))
         if ((st = alloc_pool(ctx, s, want)) != UMBRA_SUCCESS)
             return st;
+    /* The most blocks the pool (one buffer) could ever hold on this device: a build that asks
+     * for more stops as soon as it does, and fails here, instead of finishing a pass of a map
+     * that can never be stored (a 4096^2 map at epsilon 0 took a minute to find out). Below
+     * 2^31 so that the block counter cannot wrap. */
+    cl_ulong max_alloc = 0;
+    UMBRA_CL(clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc,
+                             &max_alloc, NULL));
+    cl_ulong limit64 = max_alloc / s->block_bytes;
+    limit64 = limit64 < ((cl_ulong)1 << 31) ? limit64 : ((cl_ulong)1 << 31);
+    if (s->limit_override)
+        limit64 = s->limit_override;
+    const cl_uint limit = (cl_uint)limit64;
     for (int attempt = 0;; ++attempt) {
         const cl_uint zero = 0, capacity = (cl_uint)s->pool_blocks;
         cl_uint next = 0, used = 0;
@@ -304,13 +317,25 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->counts));
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->counter));
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof capacity, &capacity));
+        UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof limit, &limit));
         size_t global[2] = {(size_t)s->tiles_per_row * T, (size_t)s->tiles_per_row * T};
         size_t local[2] = {T, T};
-        if ((st = run_kernel(r, s->k_build, global, local, ms)) != UMBRA_SUCCESS)
+        if ((st = umbra__run_2d(r, s->k_build, global, local,
+                                umbra__ray_samples(r, r->shadow.map_step) * r->shadow.prefilter,
+                                ms, "umbra_renderer_render")) != UMBRA_SUCCESS)
             return st;
         s->build_passes++;
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, s->counter, CL_TRUE, 0, sizeof used, &used, 0,
                                      NULL, NULL));
+        s->asked_blocks = used;
+        if (used >= limit)
+            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                               "umbra_renderer_render: the deep shadow map of %u x %u texels at "
+                               "epsilon %g needs more than %u blocks of %zu bytes, more than "
+                               "the device's largest allocation (%llu bytes) holds; raise "
+                               "epsilon or map_step, set max_nodes, or lower map_size", n, n,
+                               (double)r->shadow.epsilon, limit, s->block_bytes,
+                               (unsigned long long)max_alloc);
         if (used <= capacity) {
             s->used_blocks = used;
             break;
@@ -343,7 +368,9 @@ static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
         return st;
     UMBRA_CL(clSetKernelArg(s->k_fixed, next++, sizeof(cl_mem), &s->fixed));
     size_t global[2] = {n, n};
-    st = run_kernel(r, s->k_fixed, global, NULL, ms);
+    st = umbra__run_2d(r, s->k_fixed, global, NULL,
+                       umbra__ray_samples(r, r->shadow.map_step) * r->shadow.prefilter, ms,
+                       "umbra_renderer_render");
     if (st == UMBRA_SUCCESS)
         s->build_passes++;
 fail:
@@ -504,6 +531,7 @@ umbra_status umbra__deep_get_info(umbra_renderer r, umbra__deep_info *out)
     out->block_bytes = s->block_bytes;
     out->pool_blocks = s->pool_blocks;
     out->used_blocks = s->used_blocks;
+    out->asked_blocks = s->asked_blocks;
     out->map_bytes = map_bytes(s);
     out->layout_bytes = layout_bytes(s);
     out->lut_bytes = lut_bytes(s);
@@ -511,6 +539,20 @@ umbra_status umbra__deep_get_info(umbra_renderer r, umbra__deep_info *out)
     out->build_passes = s->build_passes;
     out->lut_builds = s->lut_builds;
     out->pool_growths = s->pool_growths;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__deep_set_limit(umbra_renderer r, size_t blocks)
+{
+    umbra_status st = check_deep(r, "umbra__deep_set_limit");
+    if (st != UMBRA_SUCCESS)
+        return st;
+    deep_state *s = state_get(r);
+    if (!s)
+        return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "umbra__deep_set_limit: out of memory");
+    s->limit_override = blocks;
+    r->built_valid = 0;
     return UMBRA_SUCCESS;
 }
 

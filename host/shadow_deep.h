@@ -21,6 +21,8 @@ typedef struct umbra__deep_info {
     size_t block_bytes;       /* K * tile^2 * node_bytes */
     size_t pool_blocks;       /* capacity of the block pool */
     size_t used_blocks;       /* blocks the last build took */
+    size_t asked_blocks;      /* blocks the last build pass asked for (it stops once past the
+                                 limit: umbra__deep_set_limit) */
     size_t map_bytes;         /* blocked: used blocks' bytes; fixed: map_size^2 * N * node_bytes */
     size_t layout_bytes;      /* head per tile + next per used block + node count per texel */
     size_t lut_bytes;         /* the segment table, 0 when lookup_table = 0 */
@@ -37,6 +39,10 @@ umbra_status umbra__deep_get_info(umbra_renderer r, umbra__deep_info *out);
  * and, with allow_growth = 0, a build that needs more fails with UMBRA_ERROR_OUT_OF_MEMORY
  * instead of growing the pool. Forces a rebuild at the next render. The technique must be deep. */
 umbra_status umbra__deep_set_pool(umbra_renderer r, size_t blocks, int allow_growth);
+
+/* Test knob: the most blocks a build may ask for before it stops and fails with
+ * UMBRA_ERROR_OUT_OF_MEMORY (0: what the device's largest allocation holds). Forces a rebuild. */
+umbra_status umbra__deep_set_limit(umbra_renderer r, size_t blocks);
 
 /* Reads the last build back (each pointer may be NULL): head (tiles_per_row^2 ints, -1 for a tile
  * without blocks), next (used_blocks ints, -1 ending a chain), counts (map_size^2 node counts)

@@ -70,7 +70,6 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    cl_event ev = NULL;
     map_state *s = r->tech_state;
     if (!s) {
         s = calloc(1, sizeof *s);
@@ -139,15 +138,9 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
     size_t global[2] = {n, n};
-    double t0 = umbra__now_ms();
-    if ((st = umbra__enqueue(ctx, s->build_kernel, 2, global, NULL, &ev)) != UMBRA_SUCCESS)
-        goto fail;
-    UMBRA_CL(clWaitForEvents(1, &ev));
-    double t = umbra__event_ms(ev);
-    *ms += t >= 0.0 ? t : umbra__now_ms() - t0;
+    st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, d->map_step), ms,
+                       "umbra_renderer_render");
 fail:
-    if (ev)
-        clReleaseEvent(ev);
     return st;
 }
 

@@ -29,7 +29,7 @@ static umbra_status tf_make(umbra_context ctx, const char *fn, float *table, uin
         free(table);
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
     }
-    tf->refs = 1;
+    atomic_init(&tf->refs, 1);
     tf->ctx = ctx;
     umbra_context_retain(ctx);
     tf->count = count;
@@ -214,12 +214,12 @@ int umbra_transfer_function_is_grey(umbra_transfer_function tf)
 void umbra_transfer_function_retain(umbra_transfer_function tf)
 {
     if (tf)
-        ++tf->refs;
+        atomic_fetch_add(&tf->refs, 1);
 }
 
 void umbra_transfer_function_release(umbra_transfer_function tf)
 {
-    if (!tf || --tf->refs > 0)
+    if (!tf || atomic_fetch_sub(&tf->refs, 1) > 1)
         return;
     if (tf->buffer)
         clReleaseMemObject(tf->buffer);

@@ -70,6 +70,14 @@ static umbra_status validate(umbra_context ctx, const umbra_volume_desc *d)
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                                "%s: spacing %g x %g x %g: every spacing must be finite and > 0", fn,
                                d->spacing[0], d->spacing[1], d->spacing[2]);
+    for (int a = 0; a < 3; ++a) {
+        double extent = (double)d->dims[a] * d->spacing[a];
+        if (!(extent <= UMBRA_MAX_EXTENT))
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: extent %g along axis %d (%u voxels x spacing %g) exceeds the "
+                               "limit %g world units (UMBRA_MAX_EXTENT)", fn, extent, a,
+                               d->dims[a], d->spacing[a], (double)UMBRA_MAX_EXTENT);
+    }
     if (d->value_range_given &&
         (!isfinite(d->value_min) || !isfinite(d->value_max) || !(d->value_max > d->value_min)))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -162,7 +170,7 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     const size_t count = (size_t)desc->dims[0] * desc->dims[1] * desc->dims[2];
     if (!v)
         goto oom;
-    v->refs = 1;
+    atomic_init(&v->refs, 1);
     v->ctx = ctx;
     umbra_context_retain(ctx);
     memcpy(v->dims, desc->dims, sizeof v->dims);
@@ -174,10 +182,12 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
         v->brick_counts[a] = (v->dims[a] + v->brick_size - 1) / v->brick_size;
     v->id = umbra__next_id(ctx);
 
-    float lo = desc->value_min, hi = desc->value_max;
+    /* The range and the mapping in double: max - min of finite floats can overflow a float
+     * (+-3e38), and lo + 1 rounds back to lo for |lo| > 2^24. */
+    double lo = desc->value_min, hi = desc->value_max;
     if (!desc->value_range_given) {
-        lo = FLT_MAX;
-        hi = -FLT_MAX;
+        lo = INFINITY;
+        hi = -INFINITY;
         for (size_t i = 0; i < count; ++i) {
             float x = voxel_at(desc->data, desc->type, i);
             if (!isfinite(x)) {
@@ -189,11 +199,18 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
             lo = x < lo ? x : lo;
             hi = x > hi ? x : hi;
         }
-        if (!(hi > lo))
-            hi = lo + 1.0f; /* a constant volume maps to 0 */
+        /* A constant volume maps to 0 (at FLT_MAX, to 1): any range around its value will do;
+         * the gap is wide enough to survive the rounding of the reported float range. */
+        if (!(hi > lo)) {
+            double gap = fmax(1.0, fabs(lo) * 0x1p-20);
+            if (lo + gap <= FLT_MAX)
+                hi = lo + gap;
+            else
+                lo -= gap;
+        }
     }
-    v->value_min = lo;
-    v->value_max = hi;
+    v->value_min = (float)lo;
+    v->value_max = (float)hi;
 
     vox = malloc(count * sizeof *vox);
     size_t nbricks = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
@@ -202,10 +219,10 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
                             sizeof *v->cell_minmax);
     if (!vox || !v->brick_minmax || !v->cell_minmax)
         goto oom;
-    const float scale = 1.0f / (hi - lo);
+    const double scale = 1.0 / (hi - lo);
     for (size_t i = 0; i < count; ++i) {
-        float x = (voxel_at(desc->data, desc->type, i) - lo) * scale;
-        vox[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : (x == x ? x : 0.0f));
+        double x = ((double)voxel_at(desc->data, desc->type, i) - lo) * scale;
+        vox[i] = x < 0.0 ? 0.0f : (x > 1.0 ? 1.0f : (x == x ? (float)x : 0.0f));
     }
     compute_bricks(v, vox);
     compute_cells(v, vox);
@@ -273,12 +290,12 @@ umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
 void umbra_volume_retain(umbra_volume v)
 {
     if (v)
-        ++v->refs;
+        atomic_fetch_add(&v->refs, 1);
 }
 
 void umbra_volume_release(umbra_volume v)
 {
-    if (!v || --v->refs > 0)
+    if (!v || atomic_fetch_sub(&v->refs, 1) > 1)
         return;
     if (v->data)
         clReleaseMemObject(v->data);

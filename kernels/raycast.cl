@@ -89,6 +89,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         const float h = F->step;
         const float jitter = (flags & UMBRA_FLAG_JITTER) ? umbra_random(F->seed, px, py, 0u) : 0.0f;
         const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+        /* At most UMBRA_MAX_RAY_SAMPLES + 1: the host refuses steps that would take more along
+         * the box's diagonal (host/renderer.c, check_ray_samples), so this fits an int. */
         const int n = (int)ceil((t1 - t0) / h - jitter);
         /* Pre-integrated mode (preint_size != 0, kernels/preintegration.cl): sample k stands for
          * the segment [t, t + h], its colour and opacity from the table at (s(t), s(t + h)), its

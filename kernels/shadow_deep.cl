@@ -528,23 +528,27 @@ inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, V
  * up to block_size nodes into its own lane of the block's layers. A tile whose rays have all
  * finished stops taking blocks. A block index at or beyond capacity is counted but not written:
  * the host reads the counter back, grows the pool to what was asked for and builds again, so no
- * node is ever dropped silently. Every work-item reaches every barrier (texels outside the map
- * take part with nothing to march). */
+ * node is ever dropped silently. A tile that is handed a block index at or beyond limit (the
+ * most blocks the device could ever hold) stops at once: the host then reports the map as too
+ * large without the rest of the build's work. Every work-item reaches every barrier (texels
+ * outside the map take part with nothing to march). */
 __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
                          __global const UmbraShadow *S, __global const deep_node *lut,
                          uint use_lut, uint prefilter, float eps, __global deep_node *nodes,
                          __global int *head, __global int *next, __global uint *counts,
-                         volatile __global uint *counter, uint capacity)
+                         volatile __global uint *counter, uint capacity, uint limit)
 {
     (void)view_tf;
     (void)view_bricks;
     const int T = (int)S->deep_tile;
     const int lane = (int)get_local_id(1) * T + (int)get_local_id(0);
-    const int tile = (int)get_group_id(1) * (int)S->tiles_per_row + (int)get_group_id(0);
     const int n = (int)S->map_size;
     const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
+    /* From the global id, not the group id: the host may launch the map in bands of rows with a
+     * global offset (host/renderer.c, umbra__run_2d). */
+    const int tile = (gy / T) * (int)S->tiles_per_row + gx / T;
     const uint K = S->block_size;
     const size_t T2 = (size_t)(T * T);
     const VolGeom g = vol_geom(F);
@@ -578,7 +582,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
             break; /* the same value for the whole work-group */
         if (lane == 0) {
             uint b = atomic_inc(counter);
-            l_block = (int)b;
+            l_block = b < limit ? (int)b : -1;
             if (b < capacity) {
                 if (prev_block < 0)
                     head[tile] = (int)b;
@@ -590,6 +594,8 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
         }
         barrier(CLK_LOCAL_MEM_FENCE);
         const int block = l_block;
+        if (block < 0)
+            break; /* beyond the limit: the host fails the build (the same for the work-group) */
         layer_end += K;
         while (written < layer_end) {
             if (ppos == npend) {

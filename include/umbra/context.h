@@ -2,7 +2,17 @@
  *
  * A context owns the OpenCL context, device and queue (or retains the application's), the cache of
  * built programs, and the error state. Every other umbra object belongs to one context and keeps
- * it alive. A context may be used from one thread at a time; two contexts never interfere.
+ * it alive.
+ *
+ * Threads. Contexts may be created, used and released on any threads at once (device discovery
+ * is serialised inside umbra_context_create, as OpenCL start-up is process-wide); two contexts
+ * never interfere. Objects of one context may also be used on different threads at once (two
+ * renderers rendering on two threads share the program cache, the queue and the error state
+ * safely; reference counts are atomic), but each object (a renderer, a volume being created or
+ * released) by one thread at a time. The error state is then shared: umbra_context_take_error
+ * and umbra_context_last_message return whichever thread's error came first or last, and their
+ * message pointers may be overwritten by the next error on any thread; for per-call errors across
+ * threads, use the callback, which runs on the thread whose call failed.
  *
  * The OpenCL contract (what umbra does with an application's OpenCL objects; each point is
  * pinned by a test in tests/test_context.c):
@@ -37,8 +47,11 @@
  *    (umbra's own queues always have it), else the host's wall clock from enqueue to completion,
  *    which includes any work queued ahead of umbra's.
  *
- * 5. Process-wide state. umbra keeps no mutable globals, installs no signal or exit handlers and
- *    starts no threads (the OpenCL implementation may). It touches the environment only in
+ * 5. Process-wide state. umbra's only mutable globals are mutexes: one serialises device
+ *    discovery (OpenCL start-up is process-wide, and PoCL's is not thread-safe), and umbra_io
+ *    holds one each around Teem, nifticlib and cJSON, which keep process-wide state of their own.
+ *    umbra installs no signal or exit handlers and starts no threads (the OpenCL implementation
+ *    may). It touches the environment only in
  *    umbra_context_create, and the application can turn each off in the description:
  *    - set_pocl_cache_dir (default 1): if POCL_CACHE_DIR is unset, umbra creates cache_dir (or
  *      $TMPDIR/umbra-pocl-cache-<uid>, else under /tmp; mode 0700) and sets POCL_CACHE_DIR to it

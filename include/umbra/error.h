@@ -21,7 +21,8 @@ typedef enum umbra_status {
     UMBRA_ERROR_IO = 5,               /* a file could not be opened, read or written */
     UMBRA_ERROR_FORMAT = 6,           /* a file was read but its contents are malformed */
     UMBRA_ERROR_UNSUPPORTED = 7,      /* valid request this device or technique cannot do */
-    UMBRA_ERROR_NO_DEVICE = 8         /* no OpenCL platform or device matched the request */
+    UMBRA_ERROR_NO_DEVICE = 8,        /* no OpenCL platform or device matched the request */
+    UMBRA_ERROR_CANCELLED = 9         /* the progress callback asked to stop; nothing is broken */
 } umbra_status;
 
 /* Static English name of a status ("UMBRA_ERROR_IO"); never NULL. */

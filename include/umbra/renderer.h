@@ -37,9 +37,15 @@ typedef enum umbra_projection {
     UMBRA_ORTHOGRAPHIC = 1
 } umbra_projection;
 
+/* Bound on the magnitude of every world coordinate the renderer is given (camera eye and target,
+ * point-light position): within it, differences and squared lengths stay finite in float.
+ * Setters refuse points beyond it with UMBRA_ERROR_INVALID_ARGUMENT naming them. */
+#define UMBRA_MAX_COORDINATE 1e18f
+
 /* A look-at camera in the volume's world (volume.h: the box is centred on the origin unless the
  * volume carries an index-to-world transform). Distances and steps keep their meaning: the
- * transform is rigid. */
+ * transform is rigid. eye and target lie within +-UMBRA_MAX_COORDINATE; up is any finite vector
+ * not parallel to the view. */
 typedef struct umbra_camera {
     umbra_projection projection;
     float eye[3];
@@ -63,9 +69,10 @@ typedef enum umbra_light_type {
 
 typedef struct umbra_light {
     umbra_light_type type;
-    float position[3];   /* point light, in the volume's world; may lie inside the volume */
+    float position[3];   /* point light, in the volume's world, within +-UMBRA_MAX_COORDINATE;
+                            may lie inside the volume */
     float direction[3];  /* directional light: the direction light travels in, in the volume's
-                            world (need not be unit) */
+                            world (need not be unit; any finite non-zero vector) */
     float color[3];      /* RGB intensity, each >= 0 */
 } umbra_light;
 
@@ -73,6 +80,13 @@ typedef enum umbra_transmission {
     UMBRA_TRANSMISSION_GREY = 0,    /* t = 0: every channel attenuated by the opacity alone */
     UMBRA_TRANSMISSION_COLORED = 1  /* t = RGB of the light transfer function */
 } umbra_transmission;
+
+/* Bound on the samples one ray may take: the box diagonal over the step, for view rays (step),
+ * shadow rays (reference_step) and light rays (map_step, slice_distance / (subsamples + 1)). A
+ * render (or query) whose volume and steps would exceed it fails with
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the count and this limit, before any work: such a volume
+ * is too anisotropic or too large for the step (raise the step, or resample the volume). */
+#define UMBRA_MAX_RAY_SAMPLES 1048576u
 
 typedef struct umbra_render_desc {
     size_t struct_size;      /* sizeof(umbra_render_desc); set by umbra_render_desc_init */
@@ -239,6 +253,20 @@ typedef struct umbra_render_stats {
 } umbra_render_stats;
 
 UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
+
+/* Progress and cancellation of long calls. Called on the calling thread during
+ * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow,
+ * between pieces of device work (bands of rows of the image or of the shadow map, groups of
+ * convolution slices), with the fraction of the call's work done: in [0, 1], non-decreasing,
+ * and exactly 1 in the last call of a call that succeeds. Return nonzero to cancel: the call
+ * waits for the piece in flight (bands are sized to about 2^25 samples), then returns
+ * UMBRA_ERROR_CANCELLED; the renderer stays usable (the next render rebuilds what was cut
+ * short). The callback must not call this renderer. */
+typedef int (*umbra_progress_callback)(void *user, float fraction);
+
+/* Installs (or with NULL removes) the progress callback; user is passed to it (borrowed). With a
+ * callback, long launches are split into bands, which changes no pixel. */
+UMBRA_API umbra_status umbra_renderer_set_progress(umbra_renderer r, umbra_progress_callback cb, void *user);
 
 #ifdef __cplusplus
 }

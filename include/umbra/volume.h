@@ -27,6 +27,11 @@ extern "C" {
 
 typedef struct umbra_volume_t *umbra_volume;
 
+/* Bound on a volume's world extent, dims * spacing, along each axis: within it the box, its
+ * diagonal and a camera framing it stay finite in float. umbra_volume_create (and the loaders)
+ * refuse a larger volume with UMBRA_ERROR_INVALID_ARGUMENT naming the extent. */
+#define UMBRA_MAX_EXTENT 1e15f
+
 typedef enum umbra_scalar_type {
     UMBRA_UINT8 = 0,
     UMBRA_UINT16 = 1,
@@ -42,9 +47,13 @@ typedef struct umbra_volume_desc {
     const void *data;        /* dims[0]*dims[1]*dims[2] voxels of type, x fastest; copied */
     umbra_scalar_type type;
     uint32_t dims[3];
-    float spacing[3];        /* world units per voxel, each > 0 (default 1) */
-    int value_range_given;   /* 0 (default): value range is the data's min and max */
-    float value_min, value_max; /* with value_range_given: maps value_min to 0, value_max to 1 */
+    float spacing[3];        /* world units per voxel, each finite and > 0 (default 1);
+                                dims * spacing at most UMBRA_MAX_EXTENT */
+    int value_range_given;   /* 0 (default): value range is the data's min and max (a constant
+                                volume maps to 0); the mapping is computed in double, so any
+                                finite float range works, +-3e38 included */
+    float value_min, value_max; /* with value_range_given: maps value_min to 0, value_max to 1;
+                                finite, max > min */
     uint32_t brick_size;     /* edge of an empty-space-skipping brick in voxels (default 16) */
     /* Index-to-world transform (see the top of this file). 0 (default): the centred box. */
     int transform_given;
