@@ -872,18 +872,26 @@ NB_MODULE(_umbra, m)
 
     nb::class_<VolumeInfo>(m, "VolumeInfo", "umbra_volume_info (x, y, z order)")
         .def_prop_ro("dims", [](const VolumeInfo &i) {
-            return std::array<uint32_t, 3>{i.info.dims[0], i.info.dims[1], i.info.dims[2]}; })
+            return nb::make_tuple(i.info.dims[0], i.info.dims[1], i.info.dims[2]); },
+            nb::sig("def dims(self, /) -> tuple[int, int, int]"), "(x, y, z) voxels")
         .def_prop_ro("spacing", [](const VolumeInfo &i) {
-            return std::array<float, 3>{i.info.spacing[0], i.info.spacing[1], i.info.spacing[2]}; })
+            return nb::make_tuple(py_float(i.info.spacing[0]), py_float(i.info.spacing[1]),
+                                 py_float(i.info.spacing[2])); },
+            nb::sig("def spacing(self, /) -> tuple[float, float, float]"), "world units per voxel, (x, y, z)")
         .def_prop_ro("extent", [](const VolumeInfo &i) {
-            return std::array<float, 3>{i.info.extent[0], i.info.extent[1], i.info.extent[2]}; },
-            "dims * spacing: the world-space box size")
+            return nb::make_tuple(py_float(i.info.extent[0]), py_float(i.info.extent[1]),
+                                 py_float(i.info.extent[2])); },
+            nb::sig("def extent(self, /) -> tuple[float, float, float]"),
+            "dims * spacing: the world-space box size, (x, y, z)")
         .def_prop_ro("value_range", [](const VolumeInfo &i) {
-            return std::make_pair(i.info.value_min, i.info.value_max); })
+            return nb::make_tuple(py_float(i.info.value_min), py_float(i.info.value_max)); },
+            nb::sig("def value_range(self, /) -> tuple[float, float]"),
+            "the values mapped to 0 and 1 before the transfer function")
         .def_prop_ro("brick_size", [](const VolumeInfo &i) { return i.info.brick_size; })
         .def_prop_ro("brick_counts", [](const VolumeInfo &i) {
-            return std::array<uint32_t, 3>{i.info.brick_counts[0], i.info.brick_counts[1],
-                                           i.info.brick_counts[2]}; })
+            return nb::make_tuple(i.info.brick_counts[0], i.info.brick_counts[1],
+                                 i.info.brick_counts[2]); },
+            nb::sig("def brick_counts(self, /) -> tuple[int, int, int]"))
         .def_prop_ro("device_bytes", [](const VolumeInfo &i) { return i.info.device_bytes; });
 
     /* ---- TransferFunction ---- */
