@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(python3-dev python3-venv python3-pip python3-numpy python3-pytest python3-nibabel
+packages=(python3-dev python3-venv python3-numpy python3-pytest python3-nibabel
           python3-pil)
 missing=()
 for p in "${packages[@]}"; do

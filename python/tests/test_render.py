@@ -35,7 +35,10 @@ def test_matches_the_cli_pixels(ctx, spheres, cli, tmp_path, technique):
                    check=True, env=env, capture_output=True)
     c_pixels = ctx.read_image(str(exr))
     with spheres.renderer() as r:
-        r.set_options(spheres.options, background=CLI_BACKGROUND)
+        # the scene's renderer carries the scene's options, as umbra-render's --scene does
+        assert r.options == spheres.options and r.options.ground_plane
+        assert r.camera == spheres.camera and r.light == spheres.light
+        r.set_options(r.options, background=CLI_BACKGROUND)
         py_pixels = r.render(W, H, technique=technique, map_size=256)
     assert py_pixels.shape == c_pixels.shape == (H, W, 4)
     # The same library on the same device: the same floats, through the EXR's float32.
