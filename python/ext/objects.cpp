@@ -342,25 +342,32 @@ void bind_objects(nb::module_ &m)
                             std::optional<umbra_shadow_desc> shadow) {
             umbra_context c = ctx.get();
             new (self) Renderer;
-            umbra_render_desc_init(&self->options);
-            umbra_shadow_desc_init(&self->shadow);
-            check(c, umbra_renderer_create(c, &self->h));
-            self->ctx = c;
-            umbra_context_retain(c);
-            if (volume)
-                renderer_set_volume(*self, nb::find(volume));
-            if (tf)
-                renderer_set_tf(*self, nb::find(tf));
-            if (light_tf)
-                renderer_set_light_tf(*self, nb::find(light_tf));
-            if (camera)
-                renderer_set_camera(*self, *camera);
-            if (light)
-                renderer_set_light(*self, *light);
-            if (options)
-                renderer_set_options(*self, *options);
-            if (shadow)
-                renderer_set_shadow(*self, *shadow);
+            /* nanobind runs no destructor for an __init__ that raised: release here what was
+             * made, or a failing setter would leak the renderer and all it retains. */
+            try {
+                umbra_render_desc_init(&self->options);
+                umbra_shadow_desc_init(&self->shadow);
+                check(c, umbra_renderer_create(c, &self->h));
+                self->ctx = c;
+                umbra_context_retain(c);
+                if (volume)
+                    renderer_set_volume(*self, nb::find(volume));
+                if (tf)
+                    renderer_set_tf(*self, nb::find(tf));
+                if (light_tf)
+                    renderer_set_light_tf(*self, nb::find(light_tf));
+                if (camera)
+                    renderer_set_camera(*self, *camera);
+                if (light)
+                    renderer_set_light(*self, *light);
+                if (options)
+                    renderer_set_options(*self, *options);
+                if (shadow)
+                    renderer_set_shadow(*self, *shadow);
+            } catch (...) {
+                self->~Renderer();
+                throw;
+            }
         }, "context"_a, "volume"_a.none() = nb::none(), "tf"_a.none() = nb::none(), nb::kw_only(),
            "light_tf"_a.none() = nb::none(), "camera"_a = nb::none(), "light"_a = nb::none(),
            "options"_a = nb::none(), "shadow"_a = nb::none(),

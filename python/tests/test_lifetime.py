@@ -64,6 +64,14 @@ def cycle(ctx, data):
     # and the same without closing: left to the garbage collector
     r = umbra.Renderer(ctx, umbra.Volume(ctx, data), umbra.TransferFunction(ctx, TF))
     r.query_shadow(np.zeros((4, 3), np.float32))
+    # a constructor that fails half-way (bad options after the volume was set) frees what it made
+    try:
+        umbra.Renderer(ctx, umbra.Volume(ctx, data), umbra.TransferFunction(ctx, TF),
+                       options=umbra.RenderOptions(step=-1))
+    except umbra.Error as e:
+        assert "step" in e.message
+    else:
+        raise AssertionError("a negative step was accepted")
 
 
 def test_no_leak_over_a_thousand_cycles(ctx):
