@@ -49,6 +49,21 @@ Volume make_volume(Context &ctx, nb::handle data, std::array<float, 3> spacing,
         d.spacing[i] = spacing[i];
     }
     d.data = a.data();
+    if (value_range && d.type == UMBRA_FLOAT32) {
+        /* umbra_volume_create scans for NaN and infinity only when it computes the range itself;
+         * with a given range a NaN would reach the device and the picture. */
+        const float *p = (const float *)d.data;
+        size_t n = (size_t)d.dims[0] * d.dims[1] * d.dims[2];
+        for (size_t i = 0; i < n; ++i)
+            if (!std::isfinite(p[i])) {
+                size_t x = i % d.dims[0], y = i / d.dims[0] % d.dims[1],
+                       z = i / ((size_t)d.dims[0] * d.dims[1]);
+                raise_invalid("umbra.Volume: voxel " + std::to_string(i) + " (z " +
+                              std::to_string(z) + ", y " + std::to_string(y) + ", x " +
+                              std::to_string(x) + ") is " + (std::isnan(p[i]) ? "nan" :
+                              p[i] > 0 ? "inf" : "-inf") + "; float volumes must be finite");
+            }
+    }
     if (value_range) {
         d.value_range_given = 1;
         d.value_min = value_range->first;

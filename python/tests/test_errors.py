@@ -46,6 +46,12 @@ def test_volume_nan_and_bad_spacing_from_the_c_library(ctx):
     with raises_invalid(r"umbra_volume_create: voxel 27 is nan") as e:
         umbra.Volume(ctx, data)
     assert e.value.status == INVALID
+    # with a given value range the C library does not scan the voxels; the binding does
+    with raises_invalid(r"voxel 27 \(z 1, y 2, x 3\) is nan"):
+        umbra.Volume(ctx, data, value_range=(0, 1))
+    data[1, 2, 3] = -np.inf
+    with raises_invalid(r"voxel 27 \(z 1, y 2, x 3\) is -inf"):
+        umbra.Volume(ctx, data, value_range=(0, 1))
     with raises_invalid("spacing"):
         umbra.Volume(ctx, np.ones((4, 4, 4), np.float32), spacing=(1, 0, 1))
 
