@@ -32,7 +32,8 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 
-namespace umbra_py {
+namespace umbra_py
+{
 
 /* ---- errors (support.cpp) ---------------------------------------------------------------------- */
 
@@ -123,9 +124,8 @@ template <class T> void apply_kwargs(T &d, const nb::kwargs &kw, const char *wha
             f->set(d, v);
         } catch (const nb::cast_error &) {
             std::string r = nb::cast<std::string>(nb::repr(v));
-            throw nb::type_error((std::string(what) + ": " + key + "=" + r + " is not a valid " +
-                                  f->type)
-                                     .c_str());
+            throw nb::type_error(
+                (std::string(what) + ": " + key + "=" + r + " is not a valid " + f->type).c_str());
         }
     }
 }

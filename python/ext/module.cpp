@@ -30,8 +30,9 @@ NB_MODULE(_umbra, m)
                "a valid request this device or technique cannot do")
         .value("ERROR_NO_DEVICE", UMBRA_ERROR_NO_DEVICE, "no OpenCL device matched the request");
 
-    nb::enum_<umbra_shadow_technique>(m, "Technique", "umbra_shadow_technique; keyword arguments "
-                                                      "also take the CLI's names ('cssm').")
+    nb::enum_<umbra_shadow_technique>(m, "Technique",
+                                      "umbra_shadow_technique; keyword arguments "
+                                      "also take the CLI's names ('cssm').")
         .value("NONE", UMBRA_SHADOW_NONE, "no shadows")
         .value("REFERENCE", UMBRA_SHADOW_REFERENCE, "exact: a shadow ray from every sample")
         .value("THRESHOLD", UMBRA_SHADOW_THRESHOLD, "opacity-threshold shadow map")
@@ -41,7 +42,8 @@ NB_MODULE(_umbra, m)
 
     nb::enum_<umbra_transmission>(m, "Transmission", "umbra_transmission")
         .value("GREY", UMBRA_TRANSMISSION_GREY, "every channel attenuated by the opacity alone")
-        .value("COLORED", UMBRA_TRANSMISSION_COLORED, "transmission colour from the light TF's RGB");
+        .value("COLORED", UMBRA_TRANSMISSION_COLORED,
+               "transmission colour from the light TF's RGB");
 
     nb::enum_<umbra_projection>(m, "Projection", "umbra_projection")
         .value("PERSPECTIVE", UMBRA_PERSPECTIVE)
@@ -64,24 +66,31 @@ NB_MODULE(_umbra, m)
         nullptr, nullptr);
     m.attr("Error") = nb::steal(error_type);
 
-    m.def("version", []() { return std::string(umbra_version()); },
-          "The C library's version, 'MAJOR.MINOR.PATCH'.");
-    m.def("scene_names", []() {
-        std::vector<std::string> v;
-        for (const char *const *n = umbra_scene_names(); *n; ++n)
-            v.push_back(*n);
-        return v;
-    }, "Names of the built-in scenes.");
-    m.def("technique_names", []() {
-        std::vector<std::string> v;
-        for (int t = 0;; ++t) {
-            const char *n = umbra_shadow_technique_name((umbra_shadow_technique)t);
-            if (!n)
-                break;
-            v.push_back(n);
-        }
-        return v;
-    }, "Names of the shadow techniques, in the order of umbra.Technique.");
+    m.def(
+        "version", []() { return std::string(umbra_version()); },
+        "The C library's version, 'MAJOR.MINOR.PATCH'.");
+    m.def(
+        "scene_names",
+        []() {
+            std::vector<std::string> v;
+            for (const char *const *n = umbra_scene_names(); *n; ++n)
+                v.push_back(*n);
+            return v;
+        },
+        "Names of the built-in scenes.");
+    m.def(
+        "technique_names",
+        []() {
+            std::vector<std::string> v;
+            for (int t = 0;; ++t) {
+                const char *n = umbra_shadow_technique_name((umbra_shadow_technique)t);
+                if (!n)
+                    break;
+                v.push_back(n);
+            }
+            return v;
+        },
+        "Names of the shadow techniques, in the order of umbra.Technique.");
 
     bind_options(m);
     bind_objects(m);

@@ -7,9 +7,11 @@
 
 #include "binding.h"
 
-namespace umbra_py {
+namespace umbra_py
+{
 
-namespace {
+namespace
+{
 
 std::string render_fields, shadow_fields;
 
@@ -17,19 +19,22 @@ template <class T> void add_field(nb::class_<T> &cls, typename Fields<T>::Field 
 {
     auto get = f.get;
     auto set = f.set;
-    cls.def_prop_rw(f.name.c_str(), [get](const T &d) { return get(d); },
-                    [set](T &d, nb::handle v) { set(d, v); }, nb::for_setter(nb::arg("value")),
-                    nb::for_getter(nb::sig(("def " + f.name + "(self, /) -> " + f.type).c_str())),
-                    nb::for_setter(nb::sig(("def " + f.name + "(self, value: " + f.type +
-                                            ", /) -> None").c_str())),
-                    f.doc.c_str());
+    cls.def_prop_rw(
+        f.name.c_str(), [get](const T &d) { return get(d); },
+        [set](T &d, nb::handle v) { set(d, v); }, nb::for_setter(nb::arg("value")),
+        nb::for_getter(nb::sig(("def " + f.name + "(self, /) -> " + f.type).c_str())),
+        nb::for_setter(
+            nb::sig(("def " + f.name + "(self, value: " + f.type + ", /) -> None").c_str())),
+        f.doc.c_str());
     Fields<T>::all().push_back(std::move(f));
 }
 
 template <class T> void field(nb::class_<T> &cls, const char *name, float T::*m, const char *doc)
 {
     add_field(cls, {name, "float", doc, [m](const T &d) { return nb::object(py_float(d.*m)); },
-                    [m](T &d, nb::handle v) { d.*m = nb::cast<float>(v); }});
+                    [m](T &d, nb::handle v) {
+                        d.*m = nb::cast<float>(v);
+                    }});
 }
 
 template <class T> void field(nb::class_<T> &cls, const char *name, uint32_t T::*m, const char *doc)
@@ -56,7 +61,7 @@ template <class T> void flag(nb::class_<T> &cls, const char *name, int T::*m, co
 template <class T, size_t N>
 void field(nb::class_<T> &cls, const char *name, float (T::*m)[N], const char *doc)
 {
-    std::string type = "tuple[" + std::string("float") ;
+    std::string type = "tuple[" + std::string("float");
     for (size_t i = 1; i < N; ++i)
         type += ", float";
     type += "]";
@@ -77,9 +82,11 @@ void field(nb::class_<T> &cls, const char *name, float (T::*m)[N], const char *d
 template <class T, class E>
 void enum_field(nb::class_<T> &cls, const char *name, E T::*m, const char *type, const char *doc)
 {
-    add_field(cls, {name, std::string(type) + " | str", doc,
-                    [m](const T &d) { return nb::cast(d.*m); },
-                    [m](T &d, nb::handle v) { d.*m = enum_from<E>(v); }});
+    add_field(cls,
+              {name, std::string(type) + " | str", doc, [m](const T &d) { return nb::cast(d.*m); },
+               [m](T &d, nb::handle v) {
+                   d.*m = enum_from<E>(v);
+               }});
 }
 
 template <class T> std::string repr_of(const T &d, const char *name)
@@ -116,8 +123,14 @@ template <class T> void make_repr(nb::class_<T> &cls, const char *name)
 
 } // namespace
 
-const std::string &render_fields_doc() { return render_fields; }
-const std::string &shadow_fields_doc() { return shadow_fields; }
+const std::string &render_fields_doc()
+{
+    return render_fields;
+}
+const std::string &shadow_fields_doc()
+{
+    return shadow_fields;
+}
 
 void bind_options(nb::module_ &m)
 {
@@ -129,7 +142,8 @@ void bind_options(nb::module_ &m)
         apply_kwargs(*d, kw, "umbra.RenderOptions");
     });
     field(ro, "step", &umbra_render_desc::step, "sampling step along view rays, in voxels");
-    flag(ro, "jitter", &umbra_render_desc::jitter, "start each ray at a seeded random fraction of a step");
+    flag(ro, "jitter", &umbra_render_desc::jitter,
+         "start each ray at a seeded random fraction of a step");
     field(ro, "seed", &umbra_render_desc::seed, "seed for the jitter (and stochastic techniques)");
     field(ro, "termination", &umbra_render_desc::termination,
           "early ray termination once accumulated opacity exceeds this (1 disables it)");
@@ -161,16 +175,20 @@ void bind_options(nb::module_ &m)
     field(so, "reference_step", &umbra_shadow_desc::reference_step,
           "reference: shadow-ray step in voxels");
     field(so, "map_size", &umbra_shadow_desc::map_size, "light-space maps: map_size^2 texels");
-    field(so, "map_step", &umbra_shadow_desc::map_step, "light-space maps: light-ray step in voxels");
+    field(so, "map_step", &umbra_shadow_desc::map_step,
+          "light-space maps: light-ray step in voxels");
     field(so, "threshold", &umbra_shadow_desc::threshold,
           "threshold map: accumulated light opacity in (0, 1) at which the depth is stored");
     field(so, "taps", &umbra_shadow_desc::taps,
           "CSSM / filtered threshold: texels averaged per lookup, 1, 7, 13 or 21");
-    field(so, "epsilon", &umbra_shadow_desc::epsilon, "deep map: compression error bound in [0, 1]");
+    field(so, "epsilon", &umbra_shadow_desc::epsilon,
+          "deep map: compression error bound in [0, 1]");
     field(so, "max_nodes", &umbra_shadow_desc::max_nodes,
           "deep map: nodes per texel, 0 (unbounded) or 2..64");
-    field(so, "block_size", &umbra_shadow_desc::block_size, "deep map: node layers per block, 1..256");
-    field(so, "prefilter", &umbra_shadow_desc::prefilter, "deep map: sub-pixel rays per texel, 1 or 5");
+    field(so, "block_size", &umbra_shadow_desc::block_size,
+          "deep map: node layers per block, 1..256");
+    field(so, "prefilter", &umbra_shadow_desc::prefilter,
+          "deep map: sub-pixel rays per texel, 1 or 5");
     flag(so, "lookup_table", &umbra_shadow_desc::lookup_table,
          "deep map: use the pre-compressed segment table");
     field(so, "seed", &umbra_shadow_desc::seed, "CSSM: seed of the random numbers");
@@ -184,59 +202,74 @@ void bind_options(nb::module_ &m)
     make_repr(so, "ShadowOptions");
 
     nb::class_<umbra_camera> cam(m, "Camera");
-    cam.def("__init__", [](umbra_camera *c, std::array<float, 3> eye, std::array<float, 3> target,
-                           std::array<float, 3> up, float fovy, std::optional<float> ortho) {
-        new (c) umbra_camera;
-        std::memset(c, 0, sizeof *c);
-        for (int i = 0; i < 3; ++i) {
-            c->eye[i] = eye[i];
-            c->target[i] = target[i];
-            c->up[i] = up[i];
-        }
-        c->fovy_degrees = fovy;
-        c->projection = ortho ? UMBRA_ORTHOGRAPHIC : UMBRA_PERSPECTIVE;
-        c->ortho_height = ortho ? *ortho : 0.0f;
-    }, "eye"_a, "target"_a = std::array<float, 3>{0, 0, 0}, "up"_a = std::array<float, 3>{0, 1, 0},
-       "fovy_degrees"_a = 30.0f, "ortho_height"_a = nb::none(),
-       "A look-at camera in world space (the volume's box is centred on the origin). With "
-       "ortho_height the projection is orthographic with that view height; otherwise "
-       "perspective with the vertical field of view fovy_degrees (30 as in umbra-render).");
-    enum_field(cam, "projection", &umbra_camera::projection, "Projection", "perspective or orthographic");
+    cam.def(
+        "__init__",
+        [](umbra_camera *c, std::array<float, 3> eye, std::array<float, 3> target,
+           std::array<float, 3> up, float fovy, std::optional<float> ortho) {
+            new (c) umbra_camera;
+            std::memset(c, 0, sizeof *c);
+            for (int i = 0; i < 3; ++i) {
+                c->eye[i] = eye[i];
+                c->target[i] = target[i];
+                c->up[i] = up[i];
+            }
+            c->fovy_degrees = fovy;
+            c->projection = ortho ? UMBRA_ORTHOGRAPHIC : UMBRA_PERSPECTIVE;
+            c->ortho_height = ortho ? *ortho : 0.0f;
+        },
+        "eye"_a, "target"_a = std::array<float, 3>{0, 0, 0}, "up"_a = std::array<float, 3>{0, 1, 0},
+        "fovy_degrees"_a = 30.0f, "ortho_height"_a = nb::none(),
+        "A look-at camera in world space (the volume's box is centred on the origin). With "
+        "ortho_height the projection is orthographic with that view height; otherwise "
+        "perspective with the vertical field of view fovy_degrees (30 as in umbra-render).");
+    enum_field(cam, "projection", &umbra_camera::projection, "Projection",
+               "perspective or orthographic");
     field(cam, "eye", &umbra_camera::eye, "eye position");
     field(cam, "target", &umbra_camera::target, "point looked at");
     field(cam, "up", &umbra_camera::up, "up direction");
-    field(cam, "fovy_degrees", &umbra_camera::fovy_degrees, "perspective: vertical field of view, (0, 180)");
-    field(cam, "ortho_height", &umbra_camera::ortho_height, "orthographic: view height in world units");
+    field(cam, "fovy_degrees", &umbra_camera::fovy_degrees,
+          "perspective: vertical field of view, (0, 180)");
+    field(cam, "ortho_height", &umbra_camera::ortho_height,
+          "orthographic: view height in world units");
     make_repr(cam, "Camera");
-    cam.def_static("orbit", [](std::array<float, 3> dir, float diag, float fovy) {
-        return umbra_camera_orbit(dir.data(), diag, fovy);
-    }, "direction"_a, "box_diagonal"_a, "fovy_degrees"_a = 30.0f,
-       "umbra_camera_orbit: looks at the centre from `direction` at a distance that frames a box "
-       "of the given diagonal.");
+    cam.def_static(
+        "orbit",
+        [](std::array<float, 3> dir, float diag, float fovy) {
+            return umbra_camera_orbit(dir.data(), diag, fovy);
+        },
+        "direction"_a, "box_diagonal"_a, "fovy_degrees"_a = 30.0f,
+        "umbra_camera_orbit: looks at the centre from `direction` at a distance that frames a box "
+        "of the given diagonal.");
 
     nb::class_<umbra_light> li(m, "Light");
-    li.def_static("directional", [](std::array<float, 3> dir, std::array<float, 3> color) {
-        umbra_light l;
-        std::memset(&l, 0, sizeof l);
-        l.type = UMBRA_LIGHT_DIRECTIONAL;
-        for (int i = 0; i < 3; ++i) {
-            l.direction[i] = dir[i];
-            l.color[i] = color[i];
-        }
-        return l;
-    }, "direction"_a, "color"_a = std::array<float, 3>{1, 1, 1},
-       "A directional light travelling along `direction` (need not be unit length).");
-    li.def_static("point", [](std::array<float, 3> pos, std::array<float, 3> color) {
-        umbra_light l;
-        std::memset(&l, 0, sizeof l);
-        l.type = UMBRA_LIGHT_POINT;
-        for (int i = 0; i < 3; ++i) {
-            l.position[i] = pos[i];
-            l.color[i] = color[i];
-        }
-        return l;
-    }, "position"_a, "color"_a = std::array<float, 3>{1, 1, 1},
-       "A point light at `position` (world units, volume centred on the origin).");
+    li.def_static(
+        "directional",
+        [](std::array<float, 3> dir, std::array<float, 3> color) {
+            umbra_light l;
+            std::memset(&l, 0, sizeof l);
+            l.type = UMBRA_LIGHT_DIRECTIONAL;
+            for (int i = 0; i < 3; ++i) {
+                l.direction[i] = dir[i];
+                l.color[i] = color[i];
+            }
+            return l;
+        },
+        "direction"_a, "color"_a = std::array<float, 3>{1, 1, 1},
+        "A directional light travelling along `direction` (need not be unit length).");
+    li.def_static(
+        "point",
+        [](std::array<float, 3> pos, std::array<float, 3> color) {
+            umbra_light l;
+            std::memset(&l, 0, sizeof l);
+            l.type = UMBRA_LIGHT_POINT;
+            for (int i = 0; i < 3; ++i) {
+                l.position[i] = pos[i];
+                l.color[i] = color[i];
+            }
+            return l;
+        },
+        "position"_a, "color"_a = std::array<float, 3>{1, 1, 1},
+        "A point light at `position` (world units, volume centred on the origin).");
     enum_field(li, "type", &umbra_light::type, "LightType", "point or directional");
     field(li, "position", &umbra_light::position, "point light: world-space position");
     field(li, "direction", &umbra_light::direction, "directional light: direction of travel");
@@ -251,16 +284,15 @@ void bind_options(nb::module_ &m)
     render_fields = field_docs(render_defaults);
     shadow_fields = field_docs(shadow_defaults);
     static std::string ro_doc;
-    ro_doc =
-        "umbra_render_desc: how a frame is drawn. RenderOptions(**fields) starts from "
-        "umbra_render_desc_init and sets the given fields:\n" + render_fields;
+    ro_doc = "umbra_render_desc: how a frame is drawn. RenderOptions(**fields) starts from "
+             "umbra_render_desc_init and sets the given fields:\n" +
+             render_fields;
     static std::string so_doc;
-    so_doc =
-        "umbra_shadow_desc: the shadow technique and its parameters. ShadowOptions(**fields) "
-        "starts from umbra_shadow_desc_init and sets the given fields:\n" + shadow_fields;
+    so_doc = "umbra_shadow_desc: the shadow technique and its parameters. ShadowOptions(**fields) "
+             "starts from umbra_shadow_desc_init and sets the given fields:\n" +
+             shadow_fields;
     nb::setattr(ro, "__doc__", nb::str(ro_doc.c_str()));
     nb::setattr(so, "__doc__", nb::str(so_doc.c_str()));
-
 }
 
 } // namespace umbra_py

@@ -7,7 +7,8 @@
 
 #include "binding.h"
 
-namespace umbra_py {
+namespace umbra_py
+{
 
 /* ---- errors --------------------------------------------------------------------------------- */
 
@@ -63,12 +64,22 @@ std::string dtype_name(nb::dlpack::dtype t)
 {
     const char *kind = "unknown";
     switch ((nb::dlpack::dtype_code)t.code) {
-    case nb::dlpack::dtype_code::Int: kind = "int"; break;
-    case nb::dlpack::dtype_code::UInt: kind = "uint"; break;
-    case nb::dlpack::dtype_code::Float: kind = "float"; break;
-    case nb::dlpack::dtype_code::Complex: kind = "complex"; break;
-    case nb::dlpack::dtype_code::Bool: return "bool";
-    default: break;
+    case nb::dlpack::dtype_code::Int:
+        kind = "int";
+        break;
+    case nb::dlpack::dtype_code::UInt:
+        kind = "uint";
+        break;
+    case nb::dlpack::dtype_code::Float:
+        kind = "float";
+        break;
+    case nb::dlpack::dtype_code::Complex:
+        kind = "complex";
+        break;
+    case nb::dlpack::dtype_code::Bool:
+        return "bool";
+    default:
+        break;
     }
     return kind + std::to_string(t.bits);
 }
@@ -127,9 +138,9 @@ float_out new_float_array(std::initializer_list<size_t> shape)
         n *= s;
     float *p = new (std::nothrow) float[n ? n : 1];
     if (!p)
-        raise_error(UMBRA_ERROR_OUT_OF_MEMORY, "cannot allocate " + std::to_string(n * 4) +
-                                                   " bytes for the result");
-    nb::capsule owner(p, [](void *q) noexcept { delete[] (float *)q; });
+        raise_error(UMBRA_ERROR_OUT_OF_MEMORY,
+                    "cannot allocate " + std::to_string(n * 4) + " bytes for the result");
+    nb::capsule owner(p, [](void *q) noexcept { delete[](float *) q; });
     return float_out(p, shape, owner);
 }
 
