@@ -17,29 +17,38 @@ Renderer close deterministically (``with`` or ``close()``) and may be garbage-co
 order: each holds a reference on the C objects it needs.
 """
 
-from ._umbra import (
-    Camera,
-    Context,
-    Error,
-    Light,
-    LightType,
-    Projection,
-    Renderer,
-    RenderOptions,
-    RenderStats,
-    Sampler,
-    Scene,
-    ShadowOptions,
-    Status,
-    Technique,
-    TransferFunction,
-    Transmission,
-    Volume,
-    VolumeInfo,
-    scene_names,
-    technique_names,
-    version,
-)
+try:
+    from ._umbra import (
+        Camera,
+        Context,
+        Error,
+        Light,
+        LightType,
+        Projection,
+        Renderer,
+        RenderOptions,
+        RenderStats,
+        Sampler,
+        Scene,
+        ShadowOptions,
+        Status,
+        Technique,
+        TransferFunction,
+        Transmission,
+        Volume,
+        VolumeInfo,
+        scene_names,
+        technique_names,
+        version,
+    )
+except ImportError as e:  # pragma: no cover - depends on how Python was started
+    if "_umbra" not in str(e):
+        raise
+    raise ImportError(
+        "umbra's compiled module is missing: this is the source folder python/umbra. Install the "
+        "package (pip install ./python, see the README's Python section) and import it from "
+        "outside python/."
+    ) from e
 
 __version__: str = version()
 
