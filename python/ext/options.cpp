@@ -1,0 +1,298 @@
+/* options.cpp: RenderOptions, ShadowOptions, Camera and Light, the C structs umbra_render_desc,
+ * umbra_shadow_desc, umbra_camera and umbra_light bound field by field. Each field is named once,
+ * with a pointer to the C member: its type and storage come from the C header, its default from
+ * the C desc_init function (never repeated here). A new C field is one more line below. */
+#include <cctype>
+#include <cstring>
+
+#include "binding.h"
+
+namespace umbra_py
+{
+
+namespace
+{
+
+std::string render_fields, shadow_fields;
+
+template <class T> void add_field(nb::class_<T> &cls, typename Fields<T>::Field f)
+{
+    auto get = f.get;
+    auto set = f.set;
+    cls.def_prop_rw(
+        f.name.c_str(), [get](const T &d) { return get(d); },
+        [set](T &d, nb::handle v) { set(d, v); }, nb::for_setter(nb::arg("value")),
+        nb::for_getter(nb::sig(("def " + f.name + "(self, /) -> " + f.type).c_str())),
+        nb::for_setter(
+            nb::sig(("def " + f.name + "(self, value: " + f.type + ", /) -> None").c_str())),
+        f.doc.c_str());
+    Fields<T>::all().push_back(std::move(f));
+}
+
+template <class T> void field(nb::class_<T> &cls, const char *name, float T::*m, const char *doc)
+{
+    add_field(cls, {name, "float", doc, [m](const T &d) { return nb::object(py_float(d.*m)); },
+                    [m](T &d, nb::handle v) {
+                        d.*m = nb::cast<float>(v);
+                    }});
+}
+
+template <class T> void field(nb::class_<T> &cls, const char *name, uint32_t T::*m, const char *doc)
+{
+    add_field(cls, {name, "int", doc, [m](const T &d) { return nb::object(nb::int_(d.*m)); },
+                    [m](T &d, nb::handle v) {
+                        if (nb::isinstance<nb::bool_>(v))
+                            throw nb::cast_error();
+                        d.*m = nb::cast<uint32_t>(v);
+                    }});
+}
+
+/* int fields of the C structs are flags ("nonzero: ..."): bound as bool. */
+template <class T> void flag(nb::class_<T> &cls, const char *name, int T::*m, const char *doc)
+{
+    add_field(cls, {name, "bool", doc, [m](const T &d) { return nb::object(nb::bool_(d.*m != 0)); },
+                    [m](T &d, nb::handle v) {
+                        if (!PyBool_Check(v.ptr()) && !PyLong_Check(v.ptr()))
+                            throw nb::cast_error();
+                        d.*m = PyObject_IsTrue(v.ptr()) ? 1 : 0;
+                    }});
+}
+
+template <class T, size_t N>
+void field(nb::class_<T> &cls, const char *name, float (T::*m)[N], const char *doc)
+{
+    std::string type = "tuple[" + std::string("float");
+    for (size_t i = 1; i < N; ++i)
+        type += ", float";
+    type += "]";
+    add_field(cls, {name, type, doc,
+                    [m](const T &d) {
+                        nb::list l;
+                        for (size_t i = 0; i < N; ++i)
+                            l.append(py_float((d.*m)[i]));
+                        return nb::object(nb::tuple(l));
+                    },
+                    [m](T &d, nb::handle v) {
+                        auto a = nb::cast<std::array<float, N>>(v);
+                        for (size_t i = 0; i < N; ++i)
+                            (d.*m)[i] = a[i];
+                    }});
+}
+
+template <class T, class E>
+void enum_field(nb::class_<T> &cls, const char *name, E T::*m, const char *type, const char *doc)
+{
+    add_field(cls,
+              {name, std::string(type) + " | str", doc, [m](const T &d) { return nb::cast(d.*m); },
+               [m](T &d, nb::handle v) {
+                   d.*m = enum_from<E>(v);
+               }});
+}
+
+template <class T> std::string repr_of(const T &d, const char *name)
+{
+    std::string s = std::string("umbra.") + name + "(";
+    bool first = true;
+    for (const auto &f : Fields<T>::all()) {
+        s += (first ? "" : ", ") + f.name + "=" + nb::cast<std::string>(nb::repr(f.get(d)));
+        first = false;
+    }
+    return s + ")";
+}
+
+/* "name: type = default  doc" per field, the defaults read from an initialised C struct. */
+template <class T> std::string field_docs(const T &defaults)
+{
+    std::string s;
+    for (const auto &f : Fields<T>::all())
+        s += "    " + f.name + " (" + f.type + ", default " +
+             nb::cast<std::string>(nb::repr(f.get(defaults))) + "): " + f.doc + "\n";
+    return s;
+}
+
+template <class T> void make_repr(nb::class_<T> &cls, const char *name)
+{
+    cls.def("__repr__", [name](const T &d) { return repr_of(d, name); });
+    cls.def("__eq__", [](const T &a, const T &b) {
+        for (const auto &f : Fields<T>::all())
+            if (!f.get(a).equal(f.get(b)))
+                return false;
+        return true;
+    });
+}
+
+} // namespace
+
+const std::string &render_fields_doc()
+{
+    return render_fields;
+}
+const std::string &shadow_fields_doc()
+{
+    return shadow_fields;
+}
+
+void bind_options(nb::module_ &m)
+{
+    /* ---- option structs, bound field by field through their C definitions ---- */
+    nb::class_<umbra_render_desc> ro(m, "RenderOptions");
+    ro.def("__init__", [](umbra_render_desc *d, const nb::kwargs &kw) {
+        new (d) umbra_render_desc;
+        umbra_render_desc_init(d);
+        apply_kwargs(*d, kw, "umbra.RenderOptions");
+    });
+    field(ro, "step", &umbra_render_desc::step, "sampling step along view rays, in voxels");
+    flag(ro, "jitter", &umbra_render_desc::jitter,
+         "start each ray at a seeded random fraction of a step");
+    field(ro, "seed", &umbra_render_desc::seed, "seed for the jitter (and stochastic techniques)");
+    field(ro, "termination", &umbra_render_desc::termination,
+          "early ray termination once accumulated opacity exceeds this (1 disables it)");
+    flag(ro, "empty_space_skipping", &umbra_render_desc::empty_space_skipping,
+         "skip bricks the transfer function makes empty");
+    flag(ro, "shading", &umbra_render_desc::shading, "gradient Blinn-Phong local shading");
+    field(ro, "kd", &umbra_render_desc::kd, "Blinn-Phong diffuse coefficient");
+    field(ro, "ks", &umbra_render_desc::ks, "Blinn-Phong specular coefficient");
+    field(ro, "shininess", &umbra_render_desc::shininess, "Blinn-Phong exponent");
+    field(ro, "ambient", &umbra_render_desc::ambient, "ambient light RGB");
+    field(ro, "background", &umbra_render_desc::background, "premultiplied RGBA behind everything");
+    flag(ro, "ground_plane", &umbra_render_desc::ground_plane,
+         "an opaque plane under the volume receives shadows");
+    field(ro, "ground_color", &umbra_render_desc::ground_color, "RGB of the ground plane");
+    field(ro, "ground_offset", &umbra_render_desc::ground_offset,
+          "gap between the box's lowest y and the plane, a fraction of the box diagonal");
+    enum_field(ro, "transmission", &umbra_render_desc::transmission, "Transmission",
+               "grey shadows, or coloured from the light transfer function's RGB");
+    make_repr(ro, "RenderOptions");
+
+    nb::class_<umbra_shadow_desc> so(m, "ShadowOptions");
+    so.def("__init__", [](umbra_shadow_desc *d, const nb::kwargs &kw) {
+        new (d) umbra_shadow_desc;
+        umbra_shadow_desc_init(d);
+        apply_kwargs(*d, kw, "umbra.ShadowOptions");
+    });
+    enum_field(so, "technique", &umbra_shadow_desc::technique, "Technique",
+               "none, reference, threshold, deep, cssm or convolution");
+    field(so, "reference_step", &umbra_shadow_desc::reference_step,
+          "reference: shadow-ray step in voxels");
+    field(so, "map_size", &umbra_shadow_desc::map_size, "light-space maps: map_size^2 texels");
+    field(so, "map_step", &umbra_shadow_desc::map_step,
+          "light-space maps: light-ray step in voxels");
+    field(so, "threshold", &umbra_shadow_desc::threshold,
+          "threshold map: accumulated light opacity in (0, 1) at which the depth is stored");
+    field(so, "taps", &umbra_shadow_desc::taps,
+          "CSSM / filtered threshold: texels averaged per lookup, 1, 7, 13 or 21");
+    field(so, "epsilon", &umbra_shadow_desc::epsilon,
+          "deep map: compression error bound in [0, 1]");
+    field(so, "max_nodes", &umbra_shadow_desc::max_nodes,
+          "deep map: nodes per texel, 0 (unbounded) or 2..64");
+    field(so, "block_size", &umbra_shadow_desc::block_size,
+          "deep map: node layers per block, 1..256");
+    field(so, "prefilter", &umbra_shadow_desc::prefilter,
+          "deep map: sub-pixel rays per texel, 1 or 5");
+    flag(so, "lookup_table", &umbra_shadow_desc::lookup_table,
+         "deep map: use the pre-compressed segment table");
+    field(so, "seed", &umbra_shadow_desc::seed, "CSSM: seed of the random numbers");
+    field(so, "slice_distance", &umbra_shadow_desc::slice_distance,
+          "convolution: voxels between slices, [0.02, 16]");
+    field(so, "subsamples", &umbra_shadow_desc::subsamples,
+          "convolution (SCS): volume samples between two slices, 0..64");
+    flag(so, "preintegrated", &umbra_shadow_desc::preintegrated, "pre-integrated segments");
+    field(so, "cone_angle_degrees", &umbra_shadow_desc::cone_angle_degrees,
+          "convolution: half-angle of the blur cone per slice, [0, 60]");
+    make_repr(so, "ShadowOptions");
+
+    nb::class_<umbra_camera> cam(m, "Camera");
+    cam.def(
+        "__init__",
+        [](umbra_camera *c, std::array<float, 3> eye, std::array<float, 3> target,
+           std::array<float, 3> up, float fovy, std::optional<float> ortho) {
+            new (c) umbra_camera;
+            std::memset(c, 0, sizeof *c);
+            for (int i = 0; i < 3; ++i) {
+                c->eye[i] = eye[i];
+                c->target[i] = target[i];
+                c->up[i] = up[i];
+            }
+            c->fovy_degrees = fovy;
+            c->projection = ortho ? UMBRA_ORTHOGRAPHIC : UMBRA_PERSPECTIVE;
+            c->ortho_height = ortho ? *ortho : 0.0f;
+        },
+        "eye"_a, "target"_a = std::array<float, 3>{0, 0, 0}, "up"_a = std::array<float, 3>{0, 1, 0},
+        "fovy_degrees"_a = 30.0f, "ortho_height"_a = nb::none(),
+        "A look-at camera in world space (the volume's box is centred on the origin). With "
+        "ortho_height the projection is orthographic with that view height; otherwise "
+        "perspective with the vertical field of view fovy_degrees (30 as in umbra-render).");
+    enum_field(cam, "projection", &umbra_camera::projection, "Projection",
+               "perspective or orthographic");
+    field(cam, "eye", &umbra_camera::eye, "eye position");
+    field(cam, "target", &umbra_camera::target, "point looked at");
+    field(cam, "up", &umbra_camera::up, "up direction");
+    field(cam, "fovy_degrees", &umbra_camera::fovy_degrees,
+          "perspective: vertical field of view, (0, 180)");
+    field(cam, "ortho_height", &umbra_camera::ortho_height,
+          "orthographic: view height in world units");
+    make_repr(cam, "Camera");
+    cam.def_static(
+        "orbit",
+        [](std::array<float, 3> dir, float diag, float fovy) {
+            return umbra_camera_orbit(dir.data(), diag, fovy);
+        },
+        "direction"_a, "box_diagonal"_a, "fovy_degrees"_a = 30.0f,
+        "umbra_camera_orbit: looks at the centre from `direction` at a distance that frames a box "
+        "of the given diagonal.");
+
+    nb::class_<umbra_light> li(m, "Light");
+    li.def_static(
+        "directional",
+        [](std::array<float, 3> dir, std::array<float, 3> color) {
+            umbra_light l;
+            std::memset(&l, 0, sizeof l);
+            l.type = UMBRA_LIGHT_DIRECTIONAL;
+            for (int i = 0; i < 3; ++i) {
+                l.direction[i] = dir[i];
+                l.color[i] = color[i];
+            }
+            return l;
+        },
+        "direction"_a, "color"_a = std::array<float, 3>{1, 1, 1},
+        "A directional light travelling along `direction` (need not be unit length).");
+    li.def_static(
+        "point",
+        [](std::array<float, 3> pos, std::array<float, 3> color) {
+            umbra_light l;
+            std::memset(&l, 0, sizeof l);
+            l.type = UMBRA_LIGHT_POINT;
+            for (int i = 0; i < 3; ++i) {
+                l.position[i] = pos[i];
+                l.color[i] = color[i];
+            }
+            return l;
+        },
+        "position"_a, "color"_a = std::array<float, 3>{1, 1, 1},
+        "A point light at `position` (world units, volume centred on the origin).");
+    enum_field(li, "type", &umbra_light::type, "LightType", "point or directional");
+    field(li, "position", &umbra_light::position, "point light: world-space position");
+    field(li, "direction", &umbra_light::direction, "directional light: direction of travel");
+    field(li, "color", &umbra_light::color, "RGB intensity, each >= 0");
+    make_repr(li, "Light");
+
+    /* Docstrings that list every field with its C default, built once from desc_init. */
+    umbra_render_desc render_defaults;
+    umbra_render_desc_init(&render_defaults);
+    umbra_shadow_desc shadow_defaults;
+    umbra_shadow_desc_init(&shadow_defaults);
+    render_fields = field_docs(render_defaults);
+    shadow_fields = field_docs(shadow_defaults);
+    static std::string ro_doc;
+    ro_doc = "umbra_render_desc: how a frame is drawn. RenderOptions(**fields) starts from "
+             "umbra_render_desc_init and sets the given fields:\n" +
+             render_fields;
+    static std::string so_doc;
+    so_doc = "umbra_shadow_desc: the shadow technique and its parameters. ShadowOptions(**fields) "
+             "starts from umbra_shadow_desc_init and sets the given fields:\n" +
+             shadow_fields;
+    nb::setattr(ro, "__doc__", nb::str(ro_doc.c_str()));
+    nb::setattr(so, "__doc__", nb::str(so_doc.c_str()));
+}
+
+} // namespace umbra_py

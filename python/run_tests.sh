@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# python/run_tests.sh BUILD_DIR: the Python package's tests (ctest runs this as test_python).
+# Builds and installs python/ with pip into a virtual environment in BUILD_DIR (Debian's pip
+# refuses system installs, PEP 668) and runs its pytest suite, which compares against
+# BUILD_DIR/umbra-render's pixels. The Debian packages it needs (python3-dev, -venv, -numpy,
+# -pytest, -nibabel, -pil) are in quickstart.sh's list; pip fetches scikit-build-core and nanobind.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=$(cd "${1:-build}" && pwd)
+
+# Debian's Python (not one earlier on PATH); NumPy, pytest, nibabel and Pillow come from Debian
+# through --system-site-packages, the build tools (scikit-build-core, nanobind) from PyPI.
+venv=$build/python-venv
+rm -rf "$venv"
+/usr/bin/python3 -m venv --system-site-packages "$venv"
+CMAKE_BUILD_PARALLEL_LEVEL=$(nproc) "$venv"/bin/pip install --quiet ./python
+export UMBRA_RENDER=$build/umbra-render
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$build/pocl-cache}
+src=$PWD
+cd "$build"   # not the source tree, so that "import umbra" finds the installed package
+"$venv"/bin/python -m pytest -q -p no:cacheprovider "$src/python/tests"

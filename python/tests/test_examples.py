@@ -1,0 +1,50 @@
+"""The examples run: a NIfTI file written with nibabel rendered with shadows, and the notebook
+helpers returning arrays and PNGs."""
+
+import importlib.util
+import pathlib
+
+import numpy as np
+import pytest
+
+import umbra
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_nifti_with_shadows(ctx, tmp_path):
+    pytest.importorskip("nibabel")
+    ex = load("render_nifti")
+    nii = tmp_path / "demo.nii.gz"
+    ex.make_demo(str(nii), n=32)
+    zyx, spacing = ex.load_nifti(str(nii))
+    assert zyx.shape == (32, 32, 32) and zyx.dtype == np.int16 and zyx.flags.c_contiguous
+    assert zyx.base is not None and zyx.base.flags.f_contiguous   # nibabel's array, transposed
+    assert spacing == pytest.approx((0.9, 0.9, 1.2))
+    png = tmp_path / "demo.png"
+    shadowed = ex.render(str(nii), str(png), "cssm", (64, 48), map_size=256)
+    plain = ex.render(str(nii), str(tmp_path / "plain.png"), "none", (64, 48))
+    back = ctx.read_image(str(png))
+    assert back.shape == (48, 64, 4)
+    # the shadow falls on the ground plane: the shadowed picture is darker
+    assert shadowed[..., :3].mean() < plain[..., :3].mean() - 0.01
+
+
+def test_notebook_helpers(ctx, tmp_path):
+    pytest.importorskip("PIL")
+    nb = load("notebook")
+    img = nb.render_scene("slab", technique="deep", width=40, height=30, ctx=ctx, map_size=128)
+    assert img.shape == (30, 40, 4) and img.dtype == np.float32
+    u8 = nb.to_uint8(img)
+    assert u8.shape == (30, 40, 4) and u8.dtype == np.uint8
+    pic = nb.show(img)
+    assert pic.size == (40, 30)
+    pic.save(tmp_path / "slab.png")
+    assert (tmp_path / "slab.png").stat().st_size > 0

@@ -1,0 +1,77 @@
+"""umbra: shadows in direct volume rendering, on OpenCL, from NumPy.
+
+A binding of the umbra C library (``umbra/umbra.h``) made with nanobind. Arrays go in and out
+without copies where the C API allows: a volume is read in place from a C-contiguous array of
+shape (z, y, x) and copied once, to the device; ``Renderer.render`` returns a new (or fills your)
+``(height, width, 4)`` float32 array of premultiplied RGBA.
+
+    import numpy as np, umbra
+    with umbra.Context() as ctx:
+        scene = umbra.Scene(ctx, "spheres")
+        with scene.renderer() as r:
+            img = r.render(256, 256, technique="cssm", taps=7)
+
+Every failure raises :class:`umbra.Error`, whose ``status`` is an :class:`umbra.Status` and whose
+``message`` is umbra's, naming the function and the value. Context, Volume, TransferFunction and
+Renderer close deterministically (``with`` or ``close()``) and may be garbage-collected in any
+order: each holds a reference on the C objects it needs.
+"""
+
+try:
+    from ._umbra import (
+        Camera,
+        Context,
+        Error,
+        Light,
+        LightType,
+        Projection,
+        Renderer,
+        RenderOptions,
+        RenderStats,
+        Sampler,
+        Scene,
+        ShadowOptions,
+        Status,
+        Technique,
+        TransferFunction,
+        Transmission,
+        Volume,
+        VolumeInfo,
+        scene_names,
+        technique_names,
+        version,
+    )
+except ImportError as e:  # pragma: no cover - depends on how Python was started
+    if "_umbra" not in str(e):
+        raise
+    raise ImportError(
+        "umbra's compiled module is missing: this is the source folder python/umbra. Install the "
+        "package (pip install ./python, see the README's Python section) and import it from "
+        "outside python/."
+    ) from e
+
+__version__: str = version()
+
+__all__ = [
+    "Camera",
+    "Context",
+    "Error",
+    "Light",
+    "LightType",
+    "Projection",
+    "Renderer",
+    "RenderOptions",
+    "RenderStats",
+    "Sampler",
+    "Scene",
+    "ShadowOptions",
+    "Status",
+    "Technique",
+    "TransferFunction",
+    "Transmission",
+    "Volume",
+    "VolumeInfo",
+    "scene_names",
+    "technique_names",
+    "version",
+]
