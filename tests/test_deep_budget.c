@@ -231,8 +231,6 @@ static void check_budgets(umbra_renderer r, const char *name, const uint32_t *bu
          * that are nearly equally good, such as 4 and 3 nodes on the shells). */
         assert_true(e >= prev - 1e-3);
         prev = e;
-
-        prev = e;
     }
     free(end);
     free(ref);
