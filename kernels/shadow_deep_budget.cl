@@ -6,8 +6,8 @@
  * them is ours (below). The lookup is shadow_deep.cl's. */
 
 /* Fixed budget: at most N = max_nodes nodes per texel. The march and the greedy fit run as
- * in deep_build (within epsilon) into a private buffer; at the end of the ray the buffer is reduced to N
- * of its nodes, chosen together to minimise the error against the whole buffer. (The old way,
+ * in deep_build (within epsilon) into a private buffer; at the end of the ray the buffer is
+ * reduced to N of its nodes, chosen together to minimise the error against the whole buffer. (The old way,
  * merging the least-cost interior node each time one too many arrived, decided before the rest
  * of the ray was known and compared only a node with its neighbours: with 3 nodes it kept a
  * skull's front and stretched the drop behind it over the skin, lighting both.)

@@ -237,7 +237,7 @@ static void check_budgets(umbra_renderer r, const char *name, const uint32_t *bu
     free(img);
 }
 
-/* ---- the cases --------------------------------------------------------------------------------- */
+/* ---- the cases ------------------------------------------------------------------------------ */
 
 static void test_budget_nested_shells_point_light_inside(void **state)
 {
