@@ -7,10 +7,10 @@
 
 /* Fixed budget: at most N = max_nodes nodes per texel. The march and the greedy fit run as
  * in deep_build (within epsilon) into a private buffer; at the end of the ray the buffer is
- * reduced to N of its nodes, chosen together to minimise the error against the whole buffer. (The old way,
- * merging the least-cost interior node each time one too many arrived, decided before the rest
- * of the ray was known and compared only a node with its neighbours: with 3 nodes it kept a
- * skull's front and stretched the drop behind it over the skin, lighting both.)
+ * reduced to N of its nodes, chosen together to minimise the error against the whole buffer.
+ * (The old way, merging the least-cost interior node each time one too many arrived, decided
+ * before the rest of the ray was known and compared only a node with its neighbours: with 3
+ * nodes it kept a skull's front and stretched the drop behind it over the skin, lighting both.)
  *  - The last node always stays: the visibility behind the volume is exact.
  *  - The first node may go: in front of the first kept node the visibility reads 1, so giving up
  *    a gentle decline in front of a cliff is one of the choices.
