@@ -14,8 +14,9 @@
  * Memory reported: used blocks x block bytes + the layout (heads, used blocks' next indices,
  * counts) + the table; for a fixed budget map_size^2 x N x node bytes + the table.
  *
- * The build kernels live in kernels/shadow_deep.cl next to the lookup but are compiled only into
- * the build program (DEEP_BUILD_KERNELS), not into every ray caster program. */
+ * The build kernels live in kernels/shadow_deep.cl next to the lookup (the fixed-budget one in
+ * kernels/shadow_deep_budget.cl) but are compiled only into the build program
+ * (DEEP_BUILD_KERNELS), not into every ray caster program. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,12 +131,13 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "shadow_deep.cl"};
+    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "shadow_deep.cl",
+                           "shadow_deep_budget.cl"};
     char options[300];
     cl_program program;
     umbra__build_options(r, options, sizeof options - 32);
     strcat(options, " -DDEEP_BUILD_KERNELS=1");
-    if ((st = umbra__program_get(ctx, files, 4, options, &program)) != UMBRA_SUCCESS)
+    if ((st = umbra__program_get(ctx, files, 5, options, &program)) != UMBRA_SUCCESS)
         return st;
     if (program == s->program && s->k_build)
         return UMBRA_SUCCESS;

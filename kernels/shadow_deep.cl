@@ -13,7 +13,8 @@
  *                     are written into blocks of block_size node layers that the tile takes from a
  *                     pool with an atomic counter;
  *   deep_build_fixed  the same march with a fixed budget of max_nodes nodes per texel in a flat
- *                     array (for comparisons at equal memory, as in the CSSM paper);
+ *                     array (for comparisons at equal memory, as in the CSSM paper), in
+ *                     kernels/shadow_deep_budget.cl;
  * and the lookup (SHADOW_FACTOR) the ray caster calls for every sample, which is all the ray
  * caster's program compiles of this file.
  *
@@ -92,11 +93,19 @@ inline void deep_fit_init(DeepFit *f)
     f->held = 0;
 }
 
-/* The node that ends the current segment at the last fed point. */
+/* The node that ends the current segment at the last fed point: per channel the slope nearest to
+ * the exact one through that point among those that keep every point of the segment within tol
+ * and put the node at or above the point (deep_fit_feed ends a segment before that becomes
+ * impossible). A node never lies below the visibility it stands for, so the next segment's origin
+ * is at or above every later point, each later window admits a slope <= 0, and the function never
+ * rises -- not even at the last point, which is fed with tolerance 0 (with nodes allowed below
+ * the curve, an exact end behind a flat stretch rose by up to tol). The fmin only absorbs
+ * rounding. */
 inline deep_node deep_fit_close(const DeepFit *f)
 {
     float dz = f->zl - f->z0;
-    light_t s = clamp((f->vl - f->v0) / dz, f->lo, f->hi);
+    light_t exact = (f->vl - f->v0) / dz;
+    light_t s = fmin(clamp(fmax(exact, f->lo), f->lo, f->hi), (light_t)(0.0f));
     light_t v = clamp(f->v0 + s * dz, (light_t)(0.0f), (light_t)(1.0f));
     return DEEP_NODE(f->zl, v);
 }
@@ -133,8 +142,10 @@ inline void deep_fit_feed(DeepFit *f, float z, light_t v, float tol, deep_node *
     light_t lo, hi;
     deep_fit_window(f, dz, v, tol, &lo, &hi);
     if (f->npts > 0) {
+        /* The segment ends at the previous point when no slope keeps every point within tol, or
+         * when none of those reaches up to this point (its node would lie below it). */
         light_t nlo = fmax(lo, f->lo), nhi = fmin(hi, f->hi);
-        if (deep_any_gt(nlo, nhi)) {
+        if (deep_any_gt(nlo, nhi) || deep_any_gt((v - f->v0) / dz, nhi)) {
             deep_node c = deep_fit_close(f);
             e[(*n)++] = c;
             f->z0 = DEEP_DEPTH(c);
@@ -616,63 +627,8 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
         counts[gy * n + gx] = written;
 }
 
-/* Fixed budget: keeps at most N = max_nodes nodes per texel. The march and the greedy fit run as
- * above (with epsilon); while more than N nodes arrive, the interior node whose removal changes
- * the function least (the largest channel distance between the node and the line joining its
- * neighbours) is merged away, so the first node (where the visibility starts to drop) and the
- * newest stay. Unused slots repeat the last node; a texel without attenuation stores (0, 1). */
-inline void deep_fixed_add(__global deep_node *o, int N, int *cnt, deep_node e)
-{
-    if (*cnt < N) {
-        o[(*cnt)++] = e;
-        return;
-    }
-    int best = 1;
-    float best_cost = UMBRA_INF;
-    for (int i = 1; i < N; ++i) {
-        deep_node a = o[i - 1], b = o[i], c = i + 1 < N ? o[i + 1] : e;
-        float span = DEEP_DEPTH(c) - DEEP_DEPTH(a);
-        float w = span > 0.0f ? (DEEP_DEPTH(b) - DEEP_DEPTH(a)) / span : 0.0f;
-        float cost = deep_max_abs(DEEP_VIS(b) - mix(DEEP_VIS(a), DEEP_VIS(c), w));
-        if (cost < best_cost) {
-            best_cost = cost;
-            best = i;
-        }
-    }
-    for (int i = best; i < N - 1; ++i)
-        o[i] = o[i + 1];
-    o[N - 1] = e;
-}
-
-__kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
-                               __global const float4 *view_tf, __global const float4 *light_tf,
-                               __global const uchar *view_bricks,
-                               __global const ulong *light_cells, __global const UmbraShadow *S,
-                               __global const deep_node *lut, uint use_lut, uint prefilter,
-                               float eps, __global deep_node *out)
-{
-    (void)view_tf;
-    (void)view_bricks;
-    const int n = (int)S->map_size;
-    const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
-    if (gx >= n || gy >= n)
-        return;
-    const int N = (int)S->max_nodes;
-    const VolGeom g = vol_geom(F);
-    __global deep_node *o = out + (size_t)(gy * n + gx) * (size_t)N;
-    DeepTexel st;
-    deep_texel_init(&st, S, g, (int2)(gx, gy), prefilter, eps);
-    deep_node e[DEEP_MAX_EMIT];
-    int cnt = 0;
-    while (!st.done) {
-        int ne = deep_step(&st, F, vol, g, light_tf, light_cells, S, lut, use_lut, e);
-        for (int q = 0; q < ne; ++q)
-            deep_fixed_add(o, N, &cnt, e[q]);
-    }
-    deep_node fill = cnt > 0 ? o[cnt - 1] : DEEP_NODE(0.0f, (light_t)(1.0f));
-    for (int q = cnt; q < N; ++q)
-        o[q] = fill;
-}
+/* deep_build_fixed, the build with a fixed node budget, is in kernels/shadow_deep_budget.cl
+ * (appended after this file in the build program only). */
 
 #endif /* DEEP_BUILD_KERNELS */
 

@@ -115,7 +115,9 @@ UMBRA_API void umbra_render_desc_init(umbra_render_desc *desc);
 typedef enum umbra_shadow_technique {
     UMBRA_SHADOW_NONE = 0,       /* shadow factor 1 everywhere */
     UMBRA_SHADOW_REFERENCE = 1,  /* exact: a shadow ray marched from every sample */
-    UMBRA_SHADOW_THRESHOLD = 2,  /* opacity-threshold shadow map */
+    UMBRA_SHADOW_THRESHOLD = 2,  /* opacity-threshold shadow map: grey and binary, it ignores
+                                    the transmission colour, so in coloured scenes where light
+                                    passes coloured material it can be worse than no shadows */
     UMBRA_SHADOW_DEEP = 3,       /* deep shadow map (Hadwiger et al. 2006) */
     UMBRA_SHADOW_CSSM = 4,       /* colored stochastic shadow map (Weidner & Linsen) */
     UMBRA_SHADOW_CONVOLUTION = 5 /* slice-based convolution shadows (ICS / SCS) */
@@ -136,14 +138,21 @@ typedef struct umbra_shadow_desc {
     float map_step;              /* light-ray step in voxels (default 0.5) */
     float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
                                     a texel's depth is stored (default 0.5); one grey depth per
-                                    texel, map_size^2 * 4 bytes */
+                                    texel, map_size^2 * 4 bytes. Everything behind that depth is
+                                    black in every channel, even where coloured transmission lets
+                                    light through (README, "Opacity-threshold shadow map") */
     uint32_t taps;               /* CSSM / filtered threshold: texels averaged per lookup, 1, 7,
                                     13 (the paper's set) or 21 (default 13); the offsets are
-                                    listed in kernels/lightspace.cl */
+                                    listed in kernels/lightspace.cl. They are fixed in texels:
+                                    more taps reach farther (radius 4, 7, 10), trading noise for
+                                    a wider blur of shadow edges */
     float epsilon;               /* deep map: compression error bound in [0, 1] (default 0.02) */
     uint32_t max_nodes;          /* deep map: fixed budget of nodes per texel, 0 (unbounded) or
                                     2..64; a node holds a depth and every channel's visibility
-                                    (4 floats for coloured light: 3 nodes = 12 values) */
+                                    (4 floats for coloured light: 3 nodes = 12 values). The
+                                    nodes kept are chosen once the whole ray is known, for the
+                                    least error; the stored function never rises and its end
+                                    value is the unbounded map's */
     uint32_t block_size;         /* deep map: node layers per block, 1..256 (default 8) */
     uint32_t prefilter;          /* deep map: sub-pixel rays per texel, 1 or 5 (default 1) */
     int lookup_table;            /* deep map: use the pre-compressed segment table (default 1) */
