@@ -121,6 +121,8 @@ UMBRA_API umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device
                                                     cl_command_queue queue,
                                                     const umbra_context_desc *desc, umbra_context *out);
 
+/* Adds one reference (for an application that keeps the context beyond its objects). NULL is a
+ * no-op. */
 UMBRA_API void umbra_context_retain(umbra_context ctx);
 /* Drops one reference; the context is destroyed when the last umbra object using it is gone.
  * NULL is a no-op. */

@@ -57,6 +57,7 @@ typedef struct umbra_raw_desc {
     size_t header_bytes;     /* bytes to skip at the start of the file (default 0) */
 } umbra_raw_desc;
 
+/* Fills desc with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_raw_desc_init(umbra_raw_desc *desc);
 
 /* Loads a headerless raw file. The file must hold exactly header_bytes + dims product * type size
@@ -84,6 +85,7 @@ typedef struct umbra_paraview_options {
     double range_min, range_max; /* with range_given: the data values the table spans */
 } umbra_paraview_options;
 
+/* Fills options with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_paraview_options_init(umbra_paraview_options *options);
 
 /* Reads a ParaView JSON colour-map preset (RGBPoints, Points with midpoint and sharpness,
