@@ -433,6 +433,7 @@ void bind_objects(nb::module_ &m)
                                              .c_str());
                 r.progress = nb::borrow(f);
             },
+            nb::for_setter(nb::arg("value").none()),
             nb::for_getter(nb::sig("def progress(self, /) -> typing.Callable[[float], "
                                    "bool | None] | None")),
             nb::for_setter(nb::sig("def progress(self, value: typing.Callable[[float], bool | "
