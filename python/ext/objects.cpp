@@ -93,6 +93,35 @@ int on_progress(void *user, float fraction)
     }
 }
 
+/* The Python garbage collector's view of a Renderer: the objects it holds. A progress callable
+ * often refers back to the renderer (a bound method of an object that owns it, a closure, a
+ * module's globals): without these slots such a cycle would never be collected. */
+int renderer_traverse(PyObject *self, visitproc visit, void *arg)
+{
+    Py_VISIT(Py_TYPE(self));
+    if (!nb::inst_ready(self))
+        return 0;
+    Renderer *r = nb::inst_ptr<Renderer>(self);
+    Py_VISIT(r->progress.ptr());
+    Py_VISIT(r->volume.ptr());
+    Py_VISIT(r->tf.ptr());
+    Py_VISIT(r->light_tf.ptr());
+    return 0;
+}
+
+/* Breaks a cycle by dropping the callable only: the C renderer keeps its own references on the
+ * volume and transfer functions, so the getters stay right. */
+int renderer_clear(PyObject *self)
+{
+    Renderer *r = nb::inst_ptr<Renderer>(self);
+    r->progress = nb::none();
+    return 0;
+}
+
+PyType_Slot renderer_slots[] = {{Py_tp_traverse, (void *)renderer_traverse},
+                                {Py_tp_clear, (void *)renderer_clear},
+                                {0, nullptr}};
+
 /* Raises what a C call with progress reports ended in: the Python exception that cancelled it
  * (the C status, CANCELLED, is then dropped from the context) or umbra.Error. */
 void finish_call(Renderer &r, umbra_status st)
@@ -252,7 +281,8 @@ void bind_objects(nb::module_ &m)
         "Draws one volume with a transfer function from a camera, lit by one light, with a shadow "
         "technique (umbra_renderer). Setters validate at once and raise umbra.Error; render() "
         "rebuilds only what changed (a shadow map is reused while the light, volume and light "
-        "transfer function stay).")
+        "transfer function stay).",
+        nb::type_slots(renderer_slots))
         .def(
             "__init__",
             [](Renderer *self, Context &ctx, Volume *volume, TransferFunction *tf,

@@ -137,3 +137,27 @@ def test_ctrl_c_during_device_work_cancels_the_render(renderer, with_callable):
 def test_progress_must_be_callable(renderer):
     with pytest.raises(TypeError, match="int is not callable"):
         renderer.progress = 3
+
+
+def test_a_callable_that_refers_to_its_renderer_is_collected(ctx):
+    # renderer -> callable -> renderer: a cycle the garbage collector must see through
+    import gc
+
+    collected = []
+
+    class Watcher:
+        def __init__(self, renderer):
+            self.renderer = renderer
+
+        def __call__(self, f):
+            return None
+
+        def __del__(self):
+            collected.append(True)
+
+    r = umbra.Scene(ctx, "spheres").renderer()
+    r.progress = Watcher(r)
+    r.render(16, 16)
+    del r
+    gc.collect()
+    assert collected
