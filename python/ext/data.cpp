@@ -140,8 +140,8 @@ void bind_data(nb::module_ &m)
             [](Volume *self, Context &ctx, nb::handle data, vec3 spacing,
                std::optional<range_t> value_range, uint32_t brick_size, std::optional<vec3> origin,
                std::optional<std::array<vec3, 3>> directions) {
-                Volume v = make_volume(ctx, data, spacing, value_range, brick_size, origin,
-                                       directions);
+                Volume v =
+                    make_volume(ctx, data, spacing, value_range, brick_size, origin, directions);
                 new (self) Volume(std::move(v));
             },
             "context"_a, "data"_a, nb::kw_only(),
@@ -284,8 +284,7 @@ void bind_data(nb::module_ &m)
                                range->first < range->second))
                     raise_invalid("umbra.TransferFunction.from_points: range (" +
                                   std::to_string(range->first) + ", " +
-                                  std::to_string(range->second) +
-                                  ") must be finite with lo < hi");
+                                  std::to_string(range->second) + ") must be finite with lo < hi");
                 std::vector<umbra_tf_point> pts(points.size());
                 for (size_t i = 0; i < points.size(); ++i) {
                     float v = points[i][0];

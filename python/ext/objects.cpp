@@ -216,7 +216,7 @@ void bind_objects(nb::module_ &m)
             "preset (a path ending in .json) with load_paraview's defaults.")
         .def("load_paraview", &load_paraview, "path"_a, nb::kw_only(), "preset"_a = nb::none(),
              "resolution"_a = 1024, "range"_a = nb::none(),
-             "TransferFunction.load_paraview(self, path, ...): a ParaView JSON preset.")
+             "A ParaView JSON preset, as TransferFunction.load_paraview(context, path, ...).")
         .def(
             "write_image",
             [](Context &c, const std::string &path, nb::handle rgba) {
