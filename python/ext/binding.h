@@ -24,6 +24,7 @@
 #include <memory>
 #include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -194,6 +195,9 @@ struct Renderer {
      * error indicator to be raised when the C call returns. */
     nb::object progress = nb::none();
     bool python_error = false;
+    /* True during a C call that reports progress: the callable must not use this renderer (the C
+     * renderer is in the middle of the call), so get() and close() refuse. */
+    bool busy = false;
     Renderer() = default;
     Renderer(const Renderer &) = delete;
     ~Renderer() { close(); }
@@ -207,6 +211,9 @@ struct Renderer {
     }
     umbra_renderer get() const
     {
+        if (busy)
+            throw std::runtime_error("umbra.Renderer: used from its own progress callback, "
+                                     "which must not call the renderer it reports on");
         if (!h)
             raise_closed("Renderer");
         return h;

@@ -84,7 +84,8 @@ int on_progress(void *user, float fraction)
     if (r.progress.is_none())
         return 0;
     try {
-        nb::object res = r.progress(py_float(fraction));
+        nb::object f = r.progress; /* the callable may replace itself */
+        nb::object res = f(py_float(fraction));
         return PyObject_IsTrue(res.ptr()) == 1 ? 1 : 0;
     } catch (nb::python_error &e) {
         e.restore();
@@ -121,6 +122,22 @@ int renderer_clear(PyObject *self)
 PyType_Slot renderer_slots[] = {{Py_tp_traverse, (void *)renderer_traverse},
                                 {Py_tp_clear, (void *)renderer_clear},
                                 {0, nullptr}};
+
+/* Marks a renderer busy for the length of a C call that reports progress. */
+struct Busy {
+    Renderer &r;
+    explicit Busy(Renderer &rr) : r(rr) { r.busy = true; }
+    ~Busy() { r.busy = false; }
+    Busy(const Busy &) = delete;
+};
+
+void renderer_close(Renderer &r)
+{
+    if (r.busy)
+        throw std::runtime_error("umbra.Renderer: closed from its own progress callback, "
+                                 "which must not call the renderer it reports on");
+    r.close();
+}
 
 /* Raises what a C call with progress reports ended in: the Python exception that cancelled it
  * (the C status, CANCELLED, is then dropped from the context) or umbra.Error. */
@@ -325,13 +342,13 @@ void bind_objects(nb::module_ &m)
             "options"_a = nb::none(), "shadow"_a = nb::none(),
             "Without a camera the renderer frames the volume; without a light it uses its default "
             "directional light.")
-        .def("close", &Renderer::close, "Drops this object's reference; idempotent.")
+        .def("close", &renderer_close, "Drops this object's reference; idempotent.")
         .def_prop_ro("closed", [](const Renderer &r) { return r.h == nullptr; })
         .def(
             "__enter__", [](nb::handle self) { return nb::borrow(self); },
             nb::sig("def __enter__(self) -> Renderer"))
         .def(
-            "__exit__", [](Renderer &r, nb::args) { r.close(); },
+            "__exit__", [](Renderer &r, nb::args) { renderer_close(r); },
             nb::sig("def __exit__(self, *args: object) -> None"))
         .def_prop_rw(
             "volume", [](const Renderer &r) { return r.volume; },
@@ -424,7 +441,12 @@ void bind_objects(nb::module_ &m)
                     dst = o.data();
                     result = nb::borrow(out);
                 }
-                finish_call(r, umbra_renderer_render(h, width, height, dst));
+                umbra_status st;
+                {
+                    Busy busy(r);
+                    st = umbra_renderer_render(h, width, height, dst);
+                }
+                finish_call(r, st);
                 return result;
             },
             "width"_a, "height"_a, nb::kw_only(), "out"_a = nb::none(), "params"_a,
@@ -446,7 +468,12 @@ void bind_objects(nb::module_ &m)
                                       std::to_string(i / 3) + " has a non-finite coordinate (" +
                                       std::to_string(p[i]) + ")");
                 float_out o = new_float_array({n, 3});
-                finish_call(r, umbra_renderer_query_shadow(h, p, n, o.data()));
+                umbra_status st;
+                {
+                    Busy busy(r);
+                    st = umbra_renderer_query_shadow(h, p, n, o.data());
+                }
+                finish_call(r, st);
                 return o;
             },
             "points"_a,
@@ -455,7 +482,8 @@ void bind_objects(nb::module_ &m)
         .def_prop_rw(
             "progress", [](const Renderer &r) { return r.progress; },
             [](Renderer &r, nb::handle f) {
-                r.get();
+                if (!r.h) /* not get(): the callable may replace itself during a call */
+                    raise_closed("Renderer");
                 if (!f.is_none() && !PyCallable_Check(f.ptr()))
                     throw nb::type_error(("umbra.Renderer.progress: a " +
                                           std::string(nb::type_name(f.type()).c_str()) +

@@ -134,6 +134,39 @@ def test_ctrl_c_during_device_work_cancels_the_render(renderer, with_callable):
     assert np.isfinite(renderer.render(W, H)).all()
 
 
+@pytest.mark.parametrize("use", ["render", "close", "stats", "set_shadow"])
+def test_the_callable_cannot_use_its_renderer(renderer, use):
+    def reenter(f):
+        if use == "render":
+            renderer.render(8, 8)
+        elif use == "close":
+            renderer.close()
+        elif use == "stats":
+            renderer.stats
+        else:
+            renderer.set_shadow(technique="none")
+
+    renderer.progress = reenter
+    with pytest.raises(RuntimeError, match="own progress callback"):
+        renderer.render(W, H)
+    renderer.progress = None
+    assert not renderer.closed
+    assert renderer.shadow.technique == umbra.Technique.CSSM
+    assert np.isfinite(renderer.render(W, H)).all()
+
+
+def test_a_callable_may_remove_itself(renderer):
+    seen = []
+
+    def once(f):
+        seen.append(f)
+        renderer.progress = None
+
+    renderer.progress = once
+    renderer.render(W, H)
+    assert len(seen) == 1 and renderer.progress is None
+
+
 def test_progress_must_be_callable(renderer):
     with pytest.raises(TypeError, match="int is not callable"):
         renderer.progress = 3
