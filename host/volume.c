@@ -183,22 +183,31 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     v->id = umbra__next_id(ctx);
 
     /* The range and the mapping in double: max - min of finite floats can overflow a float
-     * (+-3e38), and lo + 1 rounds back to lo for |lo| > 2^24. */
+     * (+-3e38), and lo + 1 rounds back to lo for |lo| > 2^24. Float data is scanned for NaN and
+     * infinity even with a given range: the mapping would clamp infinity to an end of the table
+     * and NaN to 0, a picture of values that are not there. Integer types are always finite. */
     double lo = desc->value_min, hi = desc->value_max;
-    if (!desc->value_range_given) {
-        lo = INFINITY;
-        hi = -INFINITY;
+    if (!desc->value_range_given || desc->type == UMBRA_FLOAT32) {
+        double dlo = INFINITY, dhi = -INFINITY;
         for (size_t i = 0; i < count; ++i) {
             float x = voxel_at(desc->data, desc->type, i);
             if (!isfinite(x)) {
+                const size_t nx = desc->dims[0], ny = desc->dims[1];
                 st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                 "umbra_volume_create: voxel %zu is %g; float volumes must be finite",
-                                 i, x);
+                                 "umbra_volume_create: voxel %zu is %g (x %zu, y %zu, z %zu); "
+                                 "float volumes must be finite",
+                                 i, x, i % nx, i / nx % ny, i / (nx * ny));
                 goto fail;
             }
-            lo = x < lo ? x : lo;
-            hi = x > hi ? x : hi;
+            dlo = x < dlo ? x : dlo;
+            dhi = x > dhi ? x : dhi;
         }
+        if (!desc->value_range_given) {
+            lo = dlo;
+            hi = dhi;
+        }
+    }
+    if (!desc->value_range_given) {
         /* A constant volume maps to 0 (at FLT_MAX, to 1): any range around its value will do;
          * the gap is wide enough to survive the rounding of the reported float range. */
         if (!(hi > lo)) {

@@ -9,7 +9,10 @@
  *  - row 6: a float volume holding +-3e38 maps its values (not all to 0), and a constant volume
  *    above 2^24 gets a non-empty value range;
  *  - row 7: a volume whose world extent is beyond UMBRA_MAX_EXTENT (or infinite) is refused at
- *    creation, from the API and from a NRRD file, naming the extent.
+ *    creation, from the API and from a NRRD file, naming the extent;
+ *  - a float volume holding NaN or infinity is refused naming the first such voxel (index, x, y,
+ *    z and value) whether the value range is given or computed (with a given range the voxels
+ *    used to go unscanned, and NaN reached the device as 0).
  *
  * Usage: test_hardening [filter] (a cmocka test-name glob). */
 #include <math.h>
@@ -335,6 +338,46 @@ static void test_nrrd_spacing_1e20_is_refused_at_load(void **state)
     remove(path);
 }
 
+/* ---- non-finite voxels ------------------------------------------------------------------- */
+
+static void test_non_finite_voxels_are_refused_with_or_without_a_range(void **state)
+{
+    umbra_context ctx = *state;
+    const float bad[] = {NAN, INFINITY, -INFINITY};
+    const char *names[] = {"nan", "inf", "-inf"};
+    float data[4 * 3 * 2];
+    for (size_t k = 0; k < 3; ++k)
+        for (int given = 0; given <= 1; ++given) {
+            for (int i = 0; i < 24; ++i)
+                data[i] = 0.25f * (float)i;
+            data[17] = bad[k]; /* x 1, y 1, z 1 of 4 x 3 x 2 */
+            data[20] = bad[k]; /* a later one is not the one named */
+            umbra_volume_desc d;
+            umbra_volume_desc_init(&d);
+            d.data = data;
+            d.type = UMBRA_FLOAT32;
+            d.dims[0] = 4;
+            d.dims[1] = 3;
+            d.dims[2] = 2;
+            d.value_range_given = given;
+            d.value_min = 0.0f;
+            d.value_max = 1.0f;
+            umbra_volume v = (umbra_volume)&d; /* must come back NULL */
+            assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_ERROR_INVALID_ARGUMENT);
+            assert_null(v);
+            char want[64];
+            snprintf(want, sizeof want, "voxel 17 is %s (x 1, y 1, z 1)", names[k]);
+            print_message("range %s: %s\n", given ? "given" : "computed",
+                          umbra_context_last_message(ctx));
+            assert_true(test_message_contains(ctx, want));
+            umbra_context_take_error(ctx, NULL);
+            /* The context stays usable, and the same data made finite is accepted. */
+            data[17] = data[20] = 0.5f;
+            assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
+            umbra_volume_release(v);
+        }
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -349,6 +392,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_constant_volume_above_2_24_has_a_value_range),
         cmocka_unit_test(test_volume_extent_beyond_limit_is_refused),
         cmocka_unit_test(test_nrrd_spacing_1e20_is_refused_at_load),
+        cmocka_unit_test(test_non_finite_voxels_are_refused_with_or_without_a_range),
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);

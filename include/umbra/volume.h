@@ -44,7 +44,9 @@ UMBRA_API size_t umbra_scalar_type_size(umbra_scalar_type type);
 
 typedef struct umbra_volume_desc {
     size_t struct_size;      /* sizeof(umbra_volume_desc); set by umbra_volume_desc_init */
-    const void *data;        /* dims[0]*dims[1]*dims[2] voxels of type, x fastest; copied */
+    const void *data;        /* dims[0]*dims[1]*dims[2] voxels of type, x fastest; copied.
+                                Float voxels must be finite, with or without a given range:
+                                UMBRA_ERROR_INVALID_ARGUMENT names the first NaN or infinity */
     umbra_scalar_type type;
     uint32_t dims[3];
     float spacing[3];        /* world units per voxel, each finite and > 0 (default 1);

@@ -1,8 +1,9 @@
 /* binding.h: what the parts of the Python module umbra._umbra share: errors raised as umbra.Error,
  * checks of NumPy arrays, the field tables of the bound C option structs, and the wrappers that
  * hold umbra's C objects. module.cpp makes the module; options.cpp binds the option structs
- * field by field through their C definitions; objects.cpp binds the objects (Context, Volume,
- * TransferFunction, Renderer, Scene); support.cpp holds the helpers' definitions. */
+ * field by field through their C definitions; objects.cpp binds Context, Renderer (with its
+ * progress callback) and Scene; data.cpp binds Volume, VolumeInfo and TransferFunction;
+ * support.cpp holds the helpers' definitions. */
 #ifndef UMBRA_PYTHON_BINDING_H
 #define UMBRA_PYTHON_BINDING_H
 
@@ -23,6 +24,7 @@
 #include <memory>
 #include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -188,6 +190,14 @@ struct Renderer {
     std::optional<umbra_light> light;
     umbra_render_desc options;
     umbra_shadow_desc shadow;
+    /* The Python progress callable (None: none), and whether a Python exception (the callable's,
+     * or KeyboardInterrupt from a signal) cancelled the call in flight and waits in Python's
+     * error indicator to be raised when the C call returns. */
+    nb::object progress = nb::none();
+    bool python_error = false;
+    /* True during a C call that reports progress: the callable must not use this renderer (the C
+     * renderer is in the middle of the call), so get() and close() refuse. */
+    bool busy = false;
     Renderer() = default;
     Renderer(const Renderer &) = delete;
     ~Renderer() { close(); }
@@ -197,10 +207,13 @@ struct Renderer {
         umbra_context_release(ctx);
         h = nullptr;
         ctx = nullptr;
-        volume = tf = light_tf = nb::none();
+        volume = tf = light_tf = progress = nb::none();
     }
     umbra_renderer get() const
     {
+        if (busy)
+            throw std::runtime_error("umbra.Renderer: used from its own progress callback, "
+                                     "which must not call the renderer it reports on");
         if (!h)
             raise_closed("Renderer");
         return h;
@@ -222,6 +235,12 @@ struct VolumeInfo {
 
 void bind_options(nb::module_ &m);
 void bind_objects(nb::module_ &m);
+/* Volume, VolumeInfo, TransferFunction (data.cpp); called by bind_objects after Context. */
+void bind_data(nb::module_ &m);
+/* Context.load_paraview and TransferFunction.load_paraview. */
+TransferFunction load_paraview(Context &ctx, const std::string &path,
+                               std::optional<std::string> preset, uint32_t resolution,
+                               std::optional<std::pair<double, double>> range);
 /* "name (type, default D): doc" lines of RenderOptions / ShadowOptions, D read from the C
  * desc_init functions; filled by bind_options. */
 const std::string &render_fields_doc();

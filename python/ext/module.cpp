@@ -28,7 +28,9 @@ NB_MODULE(_umbra, m)
         .value("ERROR_FORMAT", UMBRA_ERROR_FORMAT, "a file's contents are malformed")
         .value("ERROR_UNSUPPORTED", UMBRA_ERROR_UNSUPPORTED,
                "a valid request this device or technique cannot do")
-        .value("ERROR_NO_DEVICE", UMBRA_ERROR_NO_DEVICE, "no OpenCL device matched the request");
+        .value("ERROR_NO_DEVICE", UMBRA_ERROR_NO_DEVICE, "no OpenCL device matched the request")
+        .value("ERROR_CANCELLED", UMBRA_ERROR_CANCELLED,
+               "the progress callback asked to stop; the renderer stays usable");
 
     nb::enum_<umbra_shadow_technique>(m, "Technique",
                                       "umbra_shadow_technique; keyword arguments "

@@ -1,6 +1,13 @@
-/* objects.cpp: Context, Volume, TransferFunction, Renderer and Scene: umbra's C objects wrapped so
- * that they close deterministically (close(), with) and may be collected in any order (each
- * wrapper retains the C objects it needs, its context included), with NumPy arrays in and out. */
+/* objects.cpp: Context, Renderer and Scene: umbra's C objects wrapped so that they close
+ * deterministically (close(), with) and may be collected in any order (each wrapper retains the
+ * C objects it needs, its context included), with NumPy arrays in and out. Volume and
+ * TransferFunction are in data.cpp.
+ *
+ * Progress and Ctrl-C. Every renderer carries a C progress callback (on_progress) for its whole
+ * life: it runs the Python progress callable, if any, and checks for signals, so that Ctrl-C
+ * cancels a long render between two bands of device work and surfaces as KeyboardInterrupt. The
+ * GIL stays held during renders: the callback runs on the calling thread and may call Python
+ * directly, and no other Python thread can reach the (single-threaded) C renderer meanwhile. */
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -12,73 +19,6 @@ namespace umbra_py
 
 namespace
 {
-
-/* The scalar type of a NumPy dtype, or a clear error naming the supported ones. */
-umbra_scalar_type scalar_type_of(nb::dlpack::dtype t)
-{
-    if (t == nb::dtype<uint8_t>())
-        return UMBRA_UINT8;
-    if (t == nb::dtype<uint16_t>())
-        return UMBRA_UINT16;
-    if (t == nb::dtype<int16_t>())
-        return UMBRA_INT16;
-    if (t == nb::dtype<float>())
-        return UMBRA_FLOAT32;
-    raise_invalid("umbra.Volume: dtype " + dtype_name(t) +
-                  " is not supported; use uint8, uint16, int16 or float32 "
-                  "(e.g. data.astype(numpy.float32))");
-}
-
-Volume make_volume(Context &ctx, nb::handle data, std::array<float, 3> spacing,
-                   std::optional<std::pair<float, float>> value_range, uint32_t brick_size)
-{
-    umbra_context c = ctx.get();
-    any_array a = as_array(data, "umbra.Volume: data");
-    umbra_volume_desc d;
-    umbra_volume_desc_init(&d);
-    d.type = scalar_type_of(a.dtype());
-    if (a.ndim() != 3)
-        raise_invalid("umbra.Volume: data has shape " + shape_text(a) +
-                      "; need a 3-D array of shape (z, y, x)");
-    need_c_contiguous(a, "umbra.Volume: data",
-                      "pass numpy.ascontiguousarray(data) (an array of shape (x, y, z) in "
-                      "Fortran order, as nibabel returns, is C-contiguous as data.T)");
-    for (int i = 0; i < 3; ++i) {
-        size_t n = a.shape(2 - i);
-        if (n > UINT32_MAX)
-            raise_invalid("umbra.Volume: axis of size " + std::to_string(n) + " is too large");
-        d.dims[i] = (uint32_t)n;
-        d.spacing[i] = spacing[i];
-    }
-    d.data = a.data();
-    if (value_range && d.type == UMBRA_FLOAT32) {
-        /* umbra_volume_create scans for NaN and infinity only when it computes the range itself;
-         * with a given range a NaN would reach the device and the picture. */
-        const float *p = (const float *)d.data;
-        size_t n = (size_t)d.dims[0] * d.dims[1] * d.dims[2];
-        for (size_t i = 0; i < n; ++i)
-            if (!std::isfinite(p[i])) {
-                size_t x = i % d.dims[0], y = i / d.dims[0] % d.dims[1],
-                       z = i / ((size_t)d.dims[0] * d.dims[1]);
-                raise_invalid("umbra.Volume: voxel " + std::to_string(i) + " (z " +
-                              std::to_string(z) + ", y " + std::to_string(y) + ", x " +
-                              std::to_string(x) + ") is " +
-                              (std::isnan(p[i]) ? "nan"
-                               : p[i] > 0       ? "inf"
-                                                : "-inf") +
-                              "; float volumes must be finite");
-            }
-    }
-    if (value_range) {
-        d.value_range_given = 1;
-        d.value_min = value_range->first;
-        d.value_max = value_range->second;
-    }
-    d.brick_size = brick_size;
-    umbra_volume v = nullptr;
-    check(c, umbra_volume_create(c, &d, &v));
-    return Volume(c, v);
-}
 
 /* ---- renderer helpers --------------------------------------------------------------------------- */
 
@@ -127,6 +67,89 @@ void renderer_set_light(Renderer &r, const umbra_light &l)
 {
     check(r.ctx, umbra_renderer_set_light(r.get(), &l));
     r.light = l;
+}
+
+/* umbra_progress_callback: nonzero cancels. A Python exception (the callable's, or
+ * KeyboardInterrupt from PyErr_CheckSignals) is left in Python's error indicator and cancels;
+ * finish_call raises it once the C call has returned. Nothing calls Python after that. */
+int on_progress(void *user, float fraction)
+{
+    Renderer &r = *(Renderer *)user;
+    if (r.python_error)
+        return 1;
+    if (PyErr_CheckSignals() != 0) {
+        r.python_error = true;
+        return 1;
+    }
+    if (r.progress.is_none())
+        return 0;
+    try {
+        nb::object f = r.progress; /* the callable may replace itself */
+        nb::object res = f(py_float(fraction));
+        return PyObject_IsTrue(res.ptr()) == 1 ? 1 : 0;
+    } catch (nb::python_error &e) {
+        e.restore();
+        r.python_error = true;
+        return 1;
+    }
+}
+
+/* The Python garbage collector's view of a Renderer: the objects it holds. A progress callable
+ * often refers back to the renderer (a bound method of an object that owns it, a closure, a
+ * module's globals): without these slots such a cycle would never be collected. */
+int renderer_traverse(PyObject *self, visitproc visit, void *arg)
+{
+    Py_VISIT(Py_TYPE(self));
+    if (!nb::inst_ready(self))
+        return 0;
+    Renderer *r = nb::inst_ptr<Renderer>(self);
+    Py_VISIT(r->progress.ptr());
+    Py_VISIT(r->volume.ptr());
+    Py_VISIT(r->tf.ptr());
+    Py_VISIT(r->light_tf.ptr());
+    return 0;
+}
+
+/* Breaks a cycle by dropping the callable only: the C renderer keeps its own references on the
+ * volume and transfer functions, so the getters stay right. */
+int renderer_clear(PyObject *self)
+{
+    Renderer *r = nb::inst_ptr<Renderer>(self);
+    r->progress = nb::none();
+    return 0;
+}
+
+PyType_Slot renderer_slots[] = {{Py_tp_traverse, (void *)renderer_traverse},
+                                {Py_tp_clear, (void *)renderer_clear},
+                                {0, nullptr}};
+
+/* Marks a renderer busy for the length of a C call that reports progress. */
+struct Busy {
+    Renderer &r;
+    explicit Busy(Renderer &rr) : r(rr) { r.busy = true; }
+    ~Busy() { r.busy = false; }
+    Busy(const Busy &) = delete;
+};
+
+void renderer_close(Renderer &r)
+{
+    if (r.busy)
+        throw std::runtime_error("umbra.Renderer: closed from its own progress callback, "
+                                 "which must not call the renderer it reports on");
+    r.close();
+}
+
+/* Raises what a C call with progress reports ended in: the Python exception that cancelled it
+ * (the C status, CANCELLED, is then dropped from the context) or umbra.Error. */
+void finish_call(Renderer &r, umbra_status st)
+{
+    if (r.python_error) {
+        r.python_error = false;
+        if (st != UMBRA_SUCCESS)
+            umbra_context_take_error(r.ctx, nullptr);
+        throw nb::python_error();
+    }
+    check(r.ctx, st);
 }
 } // namespace
 
@@ -194,7 +217,10 @@ void bind_objects(nb::module_ &m)
                 check(c.get(), umbra_volume_load(c.get(), path.c_str(), &v));
                 return Volume(c.h, v);
             },
-            "path"_a, "Loads .nrrd/.nhdr (Teem) or .dat (Voreen) through umbra_io.")
+            "path"_a,
+            "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib) or .dat (Voreen) "
+            "through umbra_io, with the file's spacing and world transform (NRRD space "
+            "directions, NIfTI sform/qform).")
         .def(
             "load_transfer_function",
             [](Context &c, const std::string &path) {
@@ -202,7 +228,12 @@ void bind_objects(nb::module_ &m)
                 check(c.get(), umbra_transfer_function_load(c.get(), path.c_str(), &t));
                 return TransferFunction(c.h, t);
             },
-            "path"_a, "Loads umbra's transfer-function text format through umbra_io.")
+            "path"_a,
+            "Loads umbra's transfer-function text format through umbra_io, or a ParaView JSON "
+            "preset (a path ending in .json) with load_paraview's defaults.")
+        .def("load_paraview", &load_paraview, "path"_a, nb::kw_only(), "preset"_a = nb::none(),
+             "resolution"_a = 1024, "range"_a = nb::none(),
+             "A ParaView JSON preset, as TransferFunction.load_paraview(context, path, ...).")
         .def(
             "write_image",
             [](Context &c, const std::string &path, nb::handle rgba) {
@@ -234,169 +265,7 @@ void bind_objects(nb::module_ &m)
             },
             "path"_a, "Reads a PNG or EXR as an (H, W, 4) float32 linear premultiplied array.");
 
-    /* ---- Volume ---- */
-    umbra_volume_desc volume_defaults;
-    umbra_volume_desc_init(&volume_defaults);
-    nb::class_<Volume>(
-        m, "Volume",
-        "A scalar volume on the device (umbra_volume). Built from a C-contiguous NumPy array of "
-        "shape (z, y, x) (x varies fastest, as in umbra), dtype uint8, uint16, int16 or float32; "
-        "the array is read in place and copied once, to the device.")
-        .def(
-            "__init__",
-            [](Volume *self, Context &ctx, nb::handle data, std::array<float, 3> spacing,
-               std::optional<std::pair<float, float>> value_range, uint32_t brick_size) {
-                Volume v = make_volume(ctx, data, spacing, value_range, brick_size);
-                new (self) Volume(std::move(v));
-            },
-            "context"_a, "data"_a, nb::kw_only(),
-            "spacing"_a =
-                std::array<float, 3>{volume_defaults.spacing[0], volume_defaults.spacing[1],
-                                     volume_defaults.spacing[2]},
-            "value_range"_a = nb::none(), "brick_size"_a = volume_defaults.brick_size,
-            "spacing: world units per voxel as (sx, sy, sz), x first like umbra's dims, i.e. the "
-            "reverse of the array's (z, y, x) axis order (SimpleITK's GetSpacing() order). "
-            "value_range: (min, max) mapped to [0, 1] before the transfer function; None: the "
-            "data's min and max. brick_size: edge of an empty-space-skipping brick in voxels.")
-        .def("close", &Volume::close, "Drops this object's reference; idempotent.")
-        .def_prop_ro("closed", [](const Volume &v) { return v.h == nullptr; })
-        .def(
-            "__enter__", [](nb::handle self) { return nb::borrow(self); },
-            nb::sig("def __enter__(self) -> Volume"))
-        .def(
-            "__exit__", [](Volume &v, nb::args) { v.close(); },
-            nb::sig("def __exit__(self, *args: object) -> None"))
-        .def_prop_ro(
-            "info",
-            [](const Volume &v) {
-                VolumeInfo i;
-                check(v.ctx, umbra_volume_get_info(v.get("Volume"), &i.info));
-                return i;
-            },
-            "umbra_volume_get_info: dims, spacing, extent, value range, bricks, device bytes.")
-        .def_prop_ro(
-            "shape",
-            [](const Volume &v) {
-                umbra_volume_info i;
-                check(v.ctx, umbra_volume_get_info(v.get("Volume"), &i));
-                return nb::make_tuple(i.dims[2], i.dims[1], i.dims[0]);
-            },
-            "(z, y, x), the shape of the array it was made from");
-
-    nb::class_<VolumeInfo>(m, "VolumeInfo", "umbra_volume_info (x, y, z order)")
-        .def_prop_ro(
-            "dims",
-            [](const VolumeInfo &i) {
-                return nb::make_tuple(i.info.dims[0], i.info.dims[1], i.info.dims[2]);
-            },
-            nb::sig("def dims(self, /) -> tuple[int, int, int]"), "(x, y, z) voxels")
-        .def_prop_ro(
-            "spacing",
-            [](const VolumeInfo &i) {
-                return nb::make_tuple(py_float(i.info.spacing[0]), py_float(i.info.spacing[1]),
-                                      py_float(i.info.spacing[2]));
-            },
-            nb::sig("def spacing(self, /) -> tuple[float, float, float]"),
-            "world units per voxel, (x, y, z)")
-        .def_prop_ro(
-            "extent",
-            [](const VolumeInfo &i) {
-                return nb::make_tuple(py_float(i.info.extent[0]), py_float(i.info.extent[1]),
-                                      py_float(i.info.extent[2]));
-            },
-            nb::sig("def extent(self, /) -> tuple[float, float, float]"),
-            "dims * spacing: the world-space box size, (x, y, z)")
-        .def_prop_ro(
-            "value_range",
-            [](const VolumeInfo &i) {
-                return nb::make_tuple(py_float(i.info.value_min), py_float(i.info.value_max));
-            },
-            nb::sig("def value_range(self, /) -> tuple[float, float]"),
-            "the values mapped to 0 and 1 before the transfer function")
-        .def_prop_ro("brick_size", [](const VolumeInfo &i) { return i.info.brick_size; })
-        .def_prop_ro(
-            "brick_counts",
-            [](const VolumeInfo &i) {
-                return nb::make_tuple(i.info.brick_counts[0], i.info.brick_counts[1],
-                                      i.info.brick_counts[2]);
-            },
-            nb::sig("def brick_counts(self, /) -> tuple[int, int, int]"))
-        .def_prop_ro("device_bytes", [](const VolumeInfo &i) { return i.info.device_bytes; });
-
-    /* ---- TransferFunction ---- */
-    nb::class_<TransferFunction>(
-        m, "TransferFunction",
-        "A 1-D RGBA transfer function (umbra_transfer_function): entries spread evenly over the "
-        "volume's normalised value range [0, 1], linearly interpolated; alpha is the opacity of "
-        "one sample per voxel.")
-        .def(
-            "__init__",
-            [](TransferFunction *self, Context &ctx, nb::handle table) {
-                umbra_context c = ctx.get();
-                any_array a = as_array(table, "umbra.TransferFunction: table");
-                const float *p = float_rows(a, 4, "umbra.TransferFunction: table", "(N, 4) RGBA");
-                if (a.shape(0) > UINT32_MAX)
-                    raise_invalid("umbra.TransferFunction: table too long");
-                umbra_transfer_function t = nullptr;
-                check(c, umbra_transfer_function_create(c, p, (uint32_t)a.shape(0), &t));
-                new (self) TransferFunction(c, t);
-            },
-            "context"_a, "table"_a,
-            "table: an (N, 4) float32 array of RGBA rows in [0, 1], N >= 2 (copied).")
-        .def_static(
-            "from_points",
-            [](Context &ctx, std::vector<std::array<float, 5>> points, uint32_t resolution) {
-                umbra_context c = ctx.get();
-                std::vector<umbra_tf_point> pts(points.size());
-                for (size_t i = 0; i < points.size(); ++i) {
-                    pts[i].value = points[i][0];
-                    for (int k = 0; k < 4; ++k)
-                        pts[i].rgba[k] = points[i][k + 1];
-                }
-                if (pts.size() > UINT32_MAX)
-                    raise_invalid("umbra.TransferFunction.from_points: too many points");
-                umbra_transfer_function t = nullptr;
-                check(c, umbra_transfer_function_create_from_points(
-                             c, pts.empty() ? nullptr : pts.data(), (uint32_t)pts.size(),
-                             resolution, &t));
-                return TransferFunction(c, t);
-            },
-            "context"_a, "points"_a, "resolution"_a = 256,
-            "Control points (value, r, g, b, a), value in [0, 1] of the normalised range, sorted; "
-            "a list of 5-tuples or an (N, 5) array. The table gets `resolution` entries (256 as in "
-            "umbra's transfer-function files).")
-        .def("close", &TransferFunction::close, "Drops this object's reference; idempotent.")
-        .def_prop_ro("closed", [](const TransferFunction &t) { return t.h == nullptr; })
-        .def(
-            "__enter__", [](nb::handle self) { return nb::borrow(self); },
-            nb::sig("def __enter__(self) -> TransferFunction"))
-        .def(
-            "__exit__", [](TransferFunction &t, nb::args) { t.close(); },
-            nb::sig("def __exit__(self, *args: object) -> None"))
-        .def("__len__",
-             [](const TransferFunction &t) {
-                 return umbra_transfer_function_size(t.get("TransferFunction"));
-             })
-        .def_prop_ro(
-            "table",
-            [](const TransferFunction &t) {
-                umbra_transfer_function h = t.get("TransferFunction");
-                /* A read-only view that keeps the table alive even if this object is closed. */
-                umbra_transfer_function_retain(h);
-                nb::capsule owner(h, [](void *q) noexcept {
-                    umbra_transfer_function_release((umbra_transfer_function)q);
-                });
-                size_t n = umbra_transfer_function_size(h);
-                return nb::ndarray<nb::numpy, const float>(umbra_transfer_function_data(h), {n, 4},
-                                                           owner);
-            },
-            nb::rv_policy::automatic, "The (N, 4) float32 RGBA table, a read-only view (no copy).")
-        .def_prop_ro(
-            "is_grey",
-            [](const TransferFunction &t) {
-                return umbra_transfer_function_is_grey(t.get("TransferFunction")) != 0;
-            },
-            "True when every visible entry has r == g == b (one light channel suffices).");
+    bind_data(m);
 
     /* ---- RenderStats ---- */
     nb::class_<umbra_render_stats>(m, "RenderStats", "umbra_render_stats of the last render")
@@ -429,7 +298,8 @@ void bind_objects(nb::module_ &m)
         "Draws one volume with a transfer function from a camera, lit by one light, with a shadow "
         "technique (umbra_renderer). Setters validate at once and raise umbra.Error; render() "
         "rebuilds only what changed (a shadow map is reused while the light, volume and light "
-        "transfer function stay).")
+        "transfer function stay).",
+        nb::type_slots(renderer_slots))
         .def(
             "__init__",
             [](Renderer *self, Context &ctx, Volume *volume, TransferFunction *tf,
@@ -446,6 +316,8 @@ void bind_objects(nb::module_ &m)
                     check(c, umbra_renderer_create(c, &self->h));
                     self->ctx = c;
                     umbra_context_retain(c);
+                    /* self lives inside its Python object and never moves. */
+                    check(c, umbra_renderer_set_progress(self->h, on_progress, self));
                     if (volume)
                         renderer_set_volume(*self, nb::find(volume));
                     if (tf)
@@ -470,13 +342,13 @@ void bind_objects(nb::module_ &m)
             "options"_a = nb::none(), "shadow"_a = nb::none(),
             "Without a camera the renderer frames the volume; without a light it uses its default "
             "directional light.")
-        .def("close", &Renderer::close, "Drops this object's reference; idempotent.")
+        .def("close", &renderer_close, "Drops this object's reference; idempotent.")
         .def_prop_ro("closed", [](const Renderer &r) { return r.h == nullptr; })
         .def(
             "__enter__", [](nb::handle self) { return nb::borrow(self); },
             nb::sig("def __enter__(self) -> Renderer"))
         .def(
-            "__exit__", [](Renderer &r, nb::args) { r.close(); },
+            "__exit__", [](Renderer &r, nb::args) { renderer_close(r); },
             nb::sig("def __exit__(self, *args: object) -> None"))
         .def_prop_rw(
             "volume", [](const Renderer &r) { return r.volume; },
@@ -569,7 +441,12 @@ void bind_objects(nb::module_ &m)
                     dst = o.data();
                     result = nb::borrow(out);
                 }
-                check(r.ctx, umbra_renderer_render(h, width, height, dst));
+                umbra_status st;
+                {
+                    Busy busy(r);
+                    st = umbra_renderer_render(h, width, height, dst);
+                }
+                finish_call(r, st);
                 return result;
             },
             "width"_a, "height"_a, nb::kw_only(), "out"_a = nb::none(), "params"_a,
@@ -591,12 +468,41 @@ void bind_objects(nb::module_ &m)
                                       std::to_string(i / 3) + " has a non-finite coordinate (" +
                                       std::to_string(p[i]) + ")");
                 float_out o = new_float_array({n, 3});
-                check(r.ctx, umbra_renderer_query_shadow(h, p, n, o.data()));
+                umbra_status st;
+                {
+                    Busy busy(r);
+                    st = umbra_renderer_query_shadow(h, p, n, o.data());
+                }
+                finish_call(r, st);
                 return o;
             },
             "points"_a,
             "The current technique's RGB shadow factor at N world-space points: an (N, 3) float32 "
             "array in, an (N, 3) float32 array out. Builds the shadow structure if needed.")
+        .def_prop_rw(
+            "progress", [](const Renderer &r) { return r.progress; },
+            [](Renderer &r, nb::handle f) {
+                if (!r.h) /* not get(): the callable may replace itself during a call */
+                    raise_closed("Renderer");
+                if (!f.is_none() && !PyCallable_Check(f.ptr()))
+                    throw nb::type_error(("umbra.Renderer.progress: a " +
+                                          std::string(nb::type_name(f.type()).c_str()) +
+                                          " is not callable; pass f(fraction) or None")
+                                             .c_str());
+                r.progress = nb::borrow(f);
+            },
+            nb::for_setter(nb::arg("value").none()),
+            nb::for_getter(nb::sig("def progress(self, /) -> typing.Callable[[float], "
+                                   "bool | None] | None")),
+            nb::for_setter(nb::sig("def progress(self, value: typing.Callable[[float], bool | "
+                                   "None] | None, /) -> None")),
+            "A callable f(fraction) run during render() and query_shadow() between pieces of "
+            "device work, with the fraction done: in [0, 1], non-decreasing, exactly 1 in the "
+            "last call of a call that succeeds. A true return value cancels: the call raises "
+            "umbra.Error with status ERROR_CANCELLED and the renderer stays usable. An exception "
+            "raised by f cancels the same way and propagates. Ctrl-C cancels every render "
+            "(with or without f) at the next piece and raises KeyboardInterrupt. f must not use "
+            "this renderer. None: no callable.")
         .def_prop_ro(
             "stats",
             [](const Renderer &r) {

@@ -219,7 +219,7 @@ void bind_options(nb::module_ &m)
         },
         "eye"_a, "target"_a = std::array<float, 3>{0, 0, 0}, "up"_a = std::array<float, 3>{0, 1, 0},
         "fovy_degrees"_a = 30.0f, "ortho_height"_a = nb::none(),
-        "A look-at camera in world space (the volume's box is centred on the origin). With "
+        "A look-at camera in the volume's world (the centred box's centre is the origin). With "
         "ortho_height the projection is orthographic with that view height; otherwise "
         "perspective with the vertical field of view fovy_degrees (30 as in umbra-render).");
     enum_field(cam, "projection", &umbra_camera::projection, "Projection",
@@ -234,12 +234,14 @@ void bind_options(nb::module_ &m)
     make_repr(cam, "Camera");
     cam.def_static(
         "orbit",
-        [](std::array<float, 3> dir, float diag, float fovy) {
-            return umbra_camera_orbit(dir.data(), diag, fovy);
+        [](std::array<float, 3> dir, float diag, float fovy, std::array<float, 3> center) {
+            return umbra_camera_orbit_at(center.data(), dir.data(), diag, fovy);
         },
         "direction"_a, "box_diagonal"_a, "fovy_degrees"_a = 30.0f,
-        "umbra_camera_orbit: looks at the centre from `direction` at a distance that frames a box "
-        "of the given diagonal.");
+        "center"_a = std::array<float, 3>{0, 0, 0},
+        "umbra_camera_orbit_at: looks at `center` (default the world origin, the centred box's "
+        "centre; for a volume with a world transform pass volume.info.center) from `direction` "
+        "at a distance that frames a box of the given diagonal (volume.info.diagonal).");
 
     nb::class_<umbra_light> li(m, "Light");
     li.def_static(

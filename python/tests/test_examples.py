@@ -24,12 +24,23 @@ def test_nifti_with_shadows(ctx, tmp_path):
     ex = load("render_nifti")
     nii = tmp_path / "demo.nii.gz"
     ex.make_demo(str(nii), n=32)
-    zyx, spacing = ex.load_nifti(str(nii))
+    zyx, spacing, origin, directions = ex.load_nifti(str(nii))
     assert zyx.shape == (32, 32, 32) and zyx.dtype == np.int16 and zyx.flags.c_contiguous
     assert zyx.base is not None and zyx.base.flags.f_contiguous   # nibabel's array, transposed
     assert spacing == pytest.approx((0.9, 0.9, 1.2))
+    assert origin == pytest.approx((28.8, 28.8, -38.4))
+    assert np.array_equal(directions, np.diag([-1.0, -1, 1]))
+    # placed where umbra's own NIfTI loader places it
+    with umbra.Volume(ctx, zyx, spacing=spacing, origin=origin, directions=directions) as mine, \
+            ctx.load_volume(str(nii)) as theirs:
+        for k in ("spacing", "origin", "directions", "center", "value_range"):
+            assert getattr(mine.info, k) == getattr(theirs.info, k), k
     png = tmp_path / "demo.png"
     shadowed = ex.render(str(nii), str(png), "cssm", (64, 48), map_size=256)
+    # with a ParaView preset in Hounsfield units
+    preset = EXAMPLES.parents[1] / "examples" / "presets" / "ct_bone.json"
+    bone = ex.render(str(nii), str(tmp_path / "bone.png"), "cssm", (64, 48), tf_path=str(preset))
+    assert np.ptp(bone[..., :3]) > 0.2
     plain = ex.render(str(nii), str(tmp_path / "plain.png"), "none", (64, 48))
     back = ctx.read_image(str(png))
     assert back.shape == (48, 64, 4)
