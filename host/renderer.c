@@ -418,7 +418,8 @@ float umbra__voxel_world(umbra_renderer r)
 
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
  * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
- * alpha_for_length in kernels/common.cl). */
+ * alpha_for_length in kernels/common.cl); step_voxels 0 copies the alphas unchanged (the light
+ * table: kernels convert the interpolated alpha to extinction per sample, kernels/common.cl). */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
 {
@@ -431,7 +432,9 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
     for (uint32_t i = 0; i < tf->count; ++i) {
         memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
         double a = tf->rgba[4 * i + 3];
-        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
+        t[4 * i + 3] = step_voxels == 0.0f ? (float)a
+                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                 : 1.0f;
     }
     release_mem(buf);
     cl_int err;
@@ -523,9 +526,9 @@ static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float s
     return st;
 }
 
-umbra_status umbra__light_tables(umbra_renderer r, float step_voxels)
+umbra_status umbra__light_tables(umbra_renderer r)
 {
-    return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf, NULL,
+    return tables(r, umbra__light_tf(r), 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
                   &r->light_cells_buf);
 }
 
@@ -696,7 +699,7 @@ static umbra_status prepare_shadow(umbra_renderer r)
 {
     umbra__frame_update_light(r);
     float light_step = r->tech->light_step ? r->tech->light_step(&r->shadow) : r->shadow.reference_step;
-    umbra_status st = umbra__light_tables(r, light_step);
+    umbra_status st = umbra__light_tables(r);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__light_key key;

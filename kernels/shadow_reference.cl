@@ -1,21 +1,72 @@
 /* kernels/shadow_reference.cl: the exact reference. From every point, a shadow ray is marched
- * toward the light with step S->step and the per-channel transmittance of the shading model is
- * accumulated. Every other technique is measured against it.
+ * toward the light with step S->step and the optical depth of the shading model (the extinction
+ * per channel of kernels/common.cl) is integrated. Every other technique is measured against it.
  *
- * Exactness: the path [t_start, t_end] inside the volume (and before a point light) is split into
- * whole steps h plus one final partial step, each sampled at its midpoint, so the segment lengths
- * add up to the path length exactly; the light table is corrected for h on the host and the final
- * step re-corrected for its fraction. A homogeneous slab therefore gives exp(-sigma d) for every h,
- * to float precision. Cells the light transfer function leaves empty are skipped on the same
- * sample grid, so skipping changes no value; the march stops once every channel is below 1e-6. */
+ * Quadrature. The path [t_start, t_end] inside the volume (and before a point light) is split
+ * into whole steps h plus one final partial step; the volume is sampled at the ends of every
+ * segment, so the first sample is the point itself (a point just inside the lit face of a sheet
+ * sees the material between it and the face, which a midpoint rule misses for up to h/2). Along a
+ * segment the value is taken to run linearly between its two end samples, and the segment's
+ * optical depth is integrated through the transfer function in value space: the value interval
+ * is split at the table's entries, where the interpolated opacity has its kinks, and each piece
+ * takes a two-point Gauss rule of the extinction (at most SEG_MAX_PIECES pieces: a segment that
+ * crosses more table entries is split into that many equal pieces). A sharp transfer-function edge
+ * therefore costs no accuracy beyond the linearity of the value along one segment (the error is
+ * second order in h where the volume is smooth), and a homogeneous medium gives exp(-sigma d) for
+ * every h. The depths are summed (Kahan-compensated) and exponentiated once, so a thin medium
+ * keeps its precision at any step (1e-6 per voxel over 512 voxels at step 0.01). The march stops
+ * once every channel is below 1e-6.
+ *
+ * Empty-space skipping: the ray walks the light's sub-cell masks; a segment whose two ends lie in
+ * cells the light transfer function leaves empty is skipped, the one ending in a visible cell is
+ * integrated from its invisible start. (A visible cell crossed between two samples in invisible
+ * cells, possible only where it holds no sample, is skipped: skipping can change a value only
+ * there.) */
 
 #define SHADOW_KERNEL_PARAMS
+
+/* The most value pieces one segment's depth is integrated over. */
+#define SEG_MAX_PIECES 64
 
 typedef struct ShadowRay {
     int unused;
 } ShadowRay;
 
 inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
+
+/* The optical depth per light channel of a segment of len voxels along which the value runs
+ * linearly from v0 to v1: len times the mean extinction over [v0, v1] of the light table
+ * (n entries). */
+inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float v1, float len,
+                             uint flags)
+{
+    const float last = (float)(n - 1);
+    const float x0 = clamp(fmin(v0, v1), 0.0f, 1.0f) * last;
+    const float x1 = clamp(fmax(v0, v1), 0.0f, 1.0f) * last;
+    const float span = x1 - x0;
+    if (!(span > 0.0f))
+        return light_depth(tf_lookup(tf, n, x0 / last), len, flags);
+    const int i0 = min((int)x0, (int)n - 2), i1 = min((int)x1, (int)n - 2);
+    const int aligned = i1 - i0 < SEG_MAX_PIECES;
+    const int np = aligned ? i1 - i0 + 1 : SEG_MAX_PIECES;
+    light_t sum = (light_t)(0.0f);
+    for (int j = 0; j < np; ++j) {
+        float a, b;
+        if (aligned) {
+            a = fmax(x0, (float)(i0 + j));
+            b = fmin(x1, (float)(i0 + j + 1));
+        } else {
+            a = x0 + span * (float)j / (float)np;
+            b = j == np - 1 ? x1 : x0 + span * (float)(j + 1) / (float)np;
+        }
+        if (!(b > a))
+            continue;
+        const float m = 0.5f * (a + b), r = 0.28867513f * (b - a); /* Gauss nodes m -+ r */
+        sum += (0.5f * (b - a)) * (light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags) +
+                                   light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags));
+    }
+    return sum * (len / span);
+}
 
 inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
                                __global const float4 *light_tf,
@@ -30,38 +81,54 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     if (!(t_end > t_start))
         return (float3)(1.0f);
     const float h = S->step;
+    const float h_vox = light_step_voxels(F, S);
     const uint n_tf = F->light_tf_size;
     const uint flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
-    float len = t_end - t_start;
-    int n_full = (int)floor(len / h);
-    float last = len - (float)n_full * h;
-    light_t T = (light_t)(1.0f);
-    /* The ray walks the cells of the light's cell masks (CellWalk) and samples only visible ones;
-     * samples before t_cell lie in a cell already found visible. */
+    const float len = t_end - t_start;
+    const int n_full = (int)floor(len / h);
+    const float last = len - (float)n_full * h;
+    /* Optical depth, with its Kahan compensation. */
+    light_t D = (light_t)(0.0f), comp = (light_t)(0.0f);
+    /* Samples at t_start + k h, k = 0 .. n_full; v_k holds the value of sample k_have. */
+    float v_k = 0.0f;
+    int k_have = -1;
+    /* The ray walks the cells of the light's cell masks (CellWalk); samples before t_cell lie in
+     * a cell already found visible. */
     CellWalk w = walk_begin(g, p, d, t_start);
     float t_cell = -UMBRA_INF;
     for (int k = 0; k < n_full;) {
-        float t = t_start + ((float)k + 0.5f) * h;
-        if (skip && t >= t_cell) {
-            k = walk_next_sample(&w, g, light_cells, t_start, h, 0.5f, k, n_full, t_end, &t_cell);
-            if (k >= n_full)
+        if (skip && t_start + (float)k * h >= t_cell) {
+            /* The first sample at or after k in a visible cell; the segment ending there
+             * starts at the sample before it. */
+            int kv = walk_next_sample(&w, g, light_cells, t_start, h, 0.0f, k, n_full + 1, t_end,
+                                      &t_cell);
+            if (kv > n_full)
                 break;
-            t = t_start + ((float)k + 0.5f) * h;
+            k = max(k, kv - 1);
         }
-        float3 q = p + t * d;
-        float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-        T *= light_pass(c, flags);
-        if (light_max(T) < 1e-6f)
+        if (k_have != k)
+            v_k = sample_volume(vol, g, p + (t_start + (float)k * h) * d);
+        const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
+        const light_t y = segment_depth(light_tf, n_tf, v_k, v_next, h_vox, flags) - comp;
+        const light_t s = D + y;
+        comp = (s - D) - y;
+        D = s;
+        if (light_min(D) > 13.815511f) /* -ln(1e-6) */
             return (float3)(0.0f);
-        ++k;
+        v_k = v_next;
+        k_have = ++k;
     }
+    /* The final partial segment, always integrated: skipping above may stop at a sample in an
+     * invisible cell before a visible one at the box face. */
     if (last > 0.0f) {
-        float3 q = p + (t_start + (float)n_full * h + 0.5f * last) * d;
-        float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-        T *= light_pass(alpha_for_fraction(c, last / h), flags);
+        const float t_k = t_start + (float)n_full * h;
+        if (k_have != n_full)
+            v_k = sample_volume(vol, g, p + t_k * d);
+        const float v_end = sample_volume(vol, g, p + t_end * d);
+        D += segment_depth(light_tf, n_tf, v_k, v_end, h_vox * (last / h), flags) - comp;
     }
-    return light_rgb(T);
+    return light_rgb(exp(-D));
 }
 
 #define SHADOW_FACTOR(sr, p) reference_shadow(F, vol, g, light_tf, light_cells, S, (p))

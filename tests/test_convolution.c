@@ -243,7 +243,8 @@ static void test_preintegration_diagonal_is_corrected_tf(void **state)
                 assert_float_equal(e[3], a, 2e-6);
                 for (int c = 0; c < 3; ++c) {
                     assert_float_equal(e[c], rgba[4 * i + c] * a, 2e-6);
-                    double tr = 1.0 - a * (colored ? 1.0 - rgba[4 * i + c] : 1.0);
+                    double tr = pow(1.0 - rgba[4 * i + 3],
+                                    len * (colored ? 1.0 - rgba[4 * i + c] : 1.0));
                     assert_float_equal(f[c], tr, 2e-6);
                 }
             }

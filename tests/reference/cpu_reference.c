@@ -29,7 +29,7 @@ typedef struct prep {
     const cpu_scene *s;
     v3 bmin, bmax, spacing, inv_spacing;
     float voxel;                  /* world length of one voxel step: the smallest spacing */
-    float *view_tf, *light_tf;    /* alpha corrected for the view step / the shadow step */
+    float *view_tf, *light_tf;    /* alpha corrected for the view step / as given (light) */
     int view_n, light_n;
     unsigned char *light_bricks;  /* per brick, visible to the light transfer function */
     uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
@@ -81,7 +81,9 @@ static float *corrected(const float *tf, int n, float step_voxels)
     for (int i = 0; i < n; ++i) {
         memcpy(t + 4 * i, tf + 4 * i, 3 * sizeof *t);
         double a = tf[4 * i + 3];
-        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
+        t[4 * i + 3] = step_voxels == 0.0f ? (float)a
+                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                 : 1.0f;
     }
     return t;
 }
@@ -314,7 +316,7 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->light_n = s->light_tf ? s->light_tf_count : s->tf_count;
     P->view_n = s->tf_count;
     P->view_tf = corrected(s->tf, s->tf_count, s->opts.step);
-    P->light_tf = corrected(ltf, P->light_n, s->reference_step);
+    P->light_tf = corrected(ltf, P->light_n, 0.0f);
     P->view_cells = cells(P, s->tf, s->tf_count);
     P->light_bricks = bricks(P, ltf, P->light_n);
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
@@ -361,23 +363,6 @@ static int brick_of(const prep *P, v3 p, int b[3])
     return (b[2] * P->nb[1] + b[1]) * P->nb[0] + b[0];
 }
 
-/* Ray parameter where o + t d leaves the brick holding o + t_now d (border bricks unbounded). */
-static float brick_exit(const prep *P, v3 o, v3 d, float t_now)
-{
-    int b[3];
-    brick_of(P, add(o, mul(d, t_now)), b);
-    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
-    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, sp[3] = {P->spacing.x, P->spacing.y, P->spacing.z};
-    float t = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        if (dd[a] > 0.0f && b[a] < P->nb[a] - 1)
-            t = fminf(t, (((float)((b[a] + 1) * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
-        if (dd[a] < 0.0f && b[a] > 0)
-            t = fminf(t, (((float)(b[a] * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
-    }
-    return t;
-}
-
 static int next_after(float t0, float h, float off, float t_exit, int k)
 {
     float kk = ceilf((t_exit - t0) / h - off);
@@ -397,16 +382,61 @@ static v3 to_light(const prep *P, v3 p, float *dist)
     return mul(P->light_vec, -1.0f);
 }
 
-static void pass(const prep *P, const float c[4], float out[3])
+/* The shading model's light transport (renderer.h): extinction -ln(1 - a) per voxel of the
+ * interpolated alpha, a at most 1 - 2^-24, times 1 - t_c per channel (t = 0 in grey mode). */
+static void depth_rate(const prep *P, const float c[4], float out[3])
 {
+    float a = c[3] < 0.99999994f ? c[3] : 0.99999994f;
+    float sigma = -log1pf(-a);
     for (int ch = 0; ch < 3; ++ch)
-        out[ch] = 1.0f - c[3] * (1.0f - (P->colored ? c[ch] : 0.0f));
+        out[ch] = sigma * (P->colored ? 1.0f - c[ch] : 1.0f);
 }
 
-/* The exact reference's shadow ray. It skips whole bricks the light transfer function leaves
- * empty, where the kernel walks their sub-cells (kernels/shadow_reference.cl): both skip only
- * samples of opacity 0 on the same sample grid, so the values agree and the simpler test stays
- * an independent check of the kernel's walk. */
+/* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
+ * the mean extinction over [v0, v1], split at the table's entries (or into 64 equal pieces if
+ * it spans more), two-point Gauss per piece, as kernels/shadow_reference.cl. */
+static void segment(const prep *P, float v0, float v1, float len, float out[3])
+{
+    const int n = P->light_n;
+    const float last = (float)(n - 1);
+    float x0 = clampf(v0 < v1 ? v0 : v1, 0.0f, 1.0f) * last;
+    float x1 = clampf(v0 < v1 ? v1 : v0, 0.0f, 1.0f) * last;
+    float span = x1 - x0, c[4], r[3];
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!(span > 0.0f)) {
+        lookup(P->light_tf, n, x0 / last, c);
+        depth_rate(P, c, r);
+        for (int ch = 0; ch < 3; ++ch)
+            out[ch] = r[ch] * len;
+        return;
+    }
+    int i0 = (int)x0 < n - 2 ? (int)x0 : n - 2, i1 = (int)x1 < n - 2 ? (int)x1 : n - 2;
+    int aligned = i1 - i0 < 64, np = aligned ? i1 - i0 + 1 : 64;
+    for (int j = 0; j < np; ++j) {
+        float a = aligned ? fmaxf(x0, (float)(i0 + j)) : x0 + span * (float)j / (float)np;
+        float b = aligned ? fminf(x1, (float)(i0 + j + 1))
+                          : (j == np - 1 ? x1 : x0 + span * (float)(j + 1) / (float)np);
+        if (!(b > a))
+            continue;
+        float m = 0.5f * (a + b), hw = 0.28867513f * (b - a);
+        for (int q = -1; q <= 1; q += 2) {
+            lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
+            depth_rate(P, c, r);
+            for (int ch = 0; ch < 3; ++ch)
+                out[ch] += 0.5f * (b - a) * r[ch];
+        }
+    }
+    for (int ch = 0; ch < 3; ++ch)
+        out[ch] *= len / span;
+}
+
+/* The exact reference's shadow ray: samples at the ends of steps of h from the point (the last
+ * step partial), each segment's optical depth integrated through the transfer function, depths
+ * summed in double and exponentiated once. It skips segments whose two ends lie in bricks the
+ * light transfer function leaves empty, where the kernel walks their sub-cells
+ * (kernels/shadow_reference.cl): both skip only segments of depth 0 (but for a visible cell
+ * crossed between two samples, which neither samples), so the simpler test stays an independent
+ * check of the kernel's walk. */
 static v3 shadow(const prep *P, v3 p)
 {
     float dist;
@@ -416,41 +446,29 @@ static v3 shadow(const prep *P, v3 p)
     float t_start = fmaxf(ta, 0.0f), t_end = fminf(tb, dist);
     if (!(t_end > t_start))
         return mk(1, 1, 1);
-    const float h = P->shadow_step;
+    const float h = P->shadow_step, h_vox = P->s->reference_step;
     float len = t_end - t_start;
     int n_full = (int)floorf(len / h);
     float last = len - (float)n_full * h;
-    float T[3] = {1, 1, 1}, c[4], f[3];
+    double D[3] = {0, 0, 0};
+    float f[3];
     int skip = P->s->opts.empty_space_skipping, b[3];
-    float t_visible = -INFINITY;
-    for (int k = 0; k < n_full;) {
-        float t = t_start + ((float)k + 0.5f) * h;
-        v3 q = add(p, mul(d, t));
-        if (skip && t >= t_visible) {
-            float t_exit = brick_exit(P, p, d, t);
-            if (!P->light_bricks[brick_of(P, q, b)]) {
-                k = next_after(t_start, h, 0.5f, t_exit, k);
-                continue;
-            }
-            t_visible = t_exit; /* the brick table is read once per brick crossed */
-        }
-        lookup(P->light_tf, P->light_n, sample(P, q), c);
-        pass(P, c, f);
+    for (int k = 0; k <= n_full; ++k) {
+        float ta_k = t_start + (float)k * h;
+        float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
+        float seg = k < n_full ? h_vox : h_vox * (last / h);
+        if (k == n_full && !(last > 0.0f))
+            break;
+        v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
+        if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
+            continue;
+        segment(P, sample(P, qa), sample(P, qb), seg, f);
         for (int ch = 0; ch < 3; ++ch)
-            T[ch] *= f[ch];
-        if (fmaxf(T[0], fmaxf(T[1], T[2])) < 1e-6f)
+            D[ch] += f[ch];
+        if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
-        ++k;
     }
-    if (last > 0.0f) {
-        v3 q = add(p, mul(d, t_start + (float)n_full * h + 0.5f * last));
-        lookup(P->light_tf, P->light_n, sample(P, q), c);
-        c[3] = c[3] < 1.0f ? -expm1f(last / h * log1pf(-c[3])) : 1.0f;
-        pass(P, c, f);
-        for (int ch = 0; ch < 3; ++ch)
-            T[ch] *= f[ch];
-    }
-    return mk(T[0], T[1], T[2]);
+    return mk((float)exp(-D[0]), (float)exp(-D[1]), (float)exp(-D[2]));
 }
 
 static v3 shadow_factor(const prep *P, v3 p)
