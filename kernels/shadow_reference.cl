@@ -38,18 +38,20 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
  * linearly from v0 to v1: len times the mean extinction over [v0, v1] of the light table
  * (n entries). */
 inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float v1, float len,
-                             uint flags)
+                             uint flags, float *spread)
 {
     const float last = (float)(n - 1);
     const float x0 = clamp(fmin(v0, v1), 0.0f, 1.0f) * last;
     const float x1 = clamp(fmax(v0, v1), 0.0f, 1.0f) * last;
     const float span = x1 - x0;
+    *spread = 0.0f;
     if (!(span > 0.0f))
         return light_depth(tf_lookup(tf, n, x0 / last), len, flags);
     const int i0 = min((int)x0, (int)n - 2), i1 = min((int)x1, (int)n - 2);
     const int aligned = i1 - i0 < SEG_MAX_PIECES;
     const int np = aligned ? i1 - i0 + 1 : SEG_MAX_PIECES;
     light_t sum = (light_t)(0.0f);
+    float lo = UMBRA_INF, hi = 0.0f;
     for (int j = 0; j < np; ++j) {
         float a, b;
         if (aligned) {
@@ -62,10 +64,59 @@ inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float 
         if (!(b > a))
             continue;
         const float m = 0.5f * (a + b), r = 0.28867513f * (b - a); /* Gauss nodes m -+ r */
-        sum += (0.5f * (b - a)) * (light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags) +
-                                   light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags));
+        const light_t s0 = light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags);
+        const light_t s1 = light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags);
+        sum += (0.5f * (b - a)) * (s0 + s1);
+        lo = fmin(lo, fmin(light_min(s0), light_min(s1)));
+        hi = fmax(hi, fmax(light_max(s0), light_max(s1)));
     }
+    *spread = (hi - lo) * len;
     return sum * (len / span);
+}
+
+/* The optical depth of the segment [ta, tb] of the ray p + t d (len voxels long) whose ends have
+ * the values va, vb: segment_depth, refined where the extinction varies along the segment by more
+ * than SEG_REFINE_DEPTH (in optical depth): there the value's curvature within the segment shifts
+ * a transfer-function feature, so the segment is halved at a new sample, down to
+ * 2^-SEG_REFINE_LEVELS of it (depth-first, with an explicit stack). */
+#define SEG_REFINE_LEVELS 3
+#define SEG_REFINE_DEPTH 2e-3f
+inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
+                               uint flags, float3 p, float3 d, float ta, float tb, float va,
+                               float vb, float len)
+{
+    float st_t[SEG_REFINE_LEVELS + 1], st_v[SEG_REFINE_LEVELS + 1];
+    int st_l[SEG_REFINE_LEVELS + 1];
+    int top = 0;
+    light_t D = (light_t)(0.0f);
+    /* The current piece is [ta, st_t[top]] with values va, st_v[top], at level st_l[top]; the
+     * stack holds the ends of the pieces still to do. */
+    st_t[0] = tb;
+    st_v[0] = vb;
+    st_l[0] = 0;
+    for (;;) {
+        const float tb_ = st_t[top], vb_ = st_v[top];
+        const int level = st_l[top];
+        const float piece = len * exp2(-(float)level);
+        float spread;
+        const light_t dd = segment_depth(tf, n, va, vb_, piece, flags, &spread);
+        if (level < SEG_REFINE_LEVELS && spread > SEG_REFINE_DEPTH) {
+            const float tm = 0.5f * (ta + tb_);
+            st_l[top] = level + 1;
+            ++top;
+            st_t[top] = tm;
+            st_v[top] = sample_volume(vol, g, p + tm * d);
+            st_l[top] = level + 1;
+            continue;
+        }
+        D += dd;
+        ta = tb_;
+        va = vb_;
+        if (top == 0)
+            break;
+        --top;
+    }
+    return D;
 }
 
 inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
@@ -110,7 +161,9 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
         if (k_have != k)
             v_k = sample_volume(vol, g, p + (t_start + (float)k * h) * d);
         const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
-        const light_t y = segment_depth(light_tf, n_tf, v_k, v_next, h_vox, flags) - comp;
+        const float ta = t_start + (float)k * h;
+        const light_t y = segment_refined(vol, g, light_tf, n_tf, flags, p, d, ta, ta + h, v_k,
+                                          v_next, h_vox) - comp;
         const light_t s = D + y;
         comp = (s - D) - y;
         D = s;
@@ -126,7 +179,8 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
         if (k_have != n_full)
             v_k = sample_volume(vol, g, p + t_k * d);
         const float v_end = sample_volume(vol, g, p + t_end * d);
-        D += segment_depth(light_tf, n_tf, v_k, v_end, h_vox * (last / h), flags) - comp;
+        D += segment_refined(vol, g, light_tf, n_tf, flags, p, d, t_k, t_end, v_k, v_end,
+                             h_vox * (last / h)) - comp;
     }
     return light_rgb(exp(-D));
 }

@@ -395,14 +395,16 @@ static void depth_rate(const prep *P, const float c[4], float out[3])
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
  * the mean extinction over [v0, v1], split at the table's entries (or into 64 equal pieces if
  * it spans more), two-point Gauss per piece, as kernels/shadow_reference.cl. */
-static void segment(const prep *P, float v0, float v1, float len, float out[3])
+static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
     const int n = P->light_n;
     const float last = (float)(n - 1);
     float x0 = clampf(v0 < v1 ? v0 : v1, 0.0f, 1.0f) * last;
     float x1 = clampf(v0 < v1 ? v1 : v0, 0.0f, 1.0f) * last;
     float span = x1 - x0, c[4], r[3];
+    float lo = INFINITY, hi = 0.0f;
     out[0] = out[1] = out[2] = 0.0f;
+    *spread = 0.0f;
     if (!(span > 0.0f)) {
         lookup(P->light_tf, n, x0 / last, c);
         depth_rate(P, c, r);
@@ -422,12 +424,33 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3])
         for (int q = -1; q <= 1; q += 2) {
             lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
             depth_rate(P, c, r);
-            for (int ch = 0; ch < 3; ++ch)
+            for (int ch = 0; ch < 3; ++ch) {
                 out[ch] += 0.5f * (b - a) * r[ch];
+                lo = fminf(lo, r[ch]);
+                hi = fmaxf(hi, r[ch]);
+            }
         }
     }
     for (int ch = 0; ch < 3; ++ch)
         out[ch] *= len / span;
+    *spread = (hi - lo) * len;
+}
+
+/* segment, halved at a new sample (recursively, at most 3 times) while the extinction varies
+ * along it by more than 2e-3 of optical depth, as kernels/shadow_reference.cl. */
+static void segment_refined(const prep *P, v3 p, v3 d, float ta, float tb, float va, float vb,
+                            float len, int level, double D[3])
+{
+    float f[3], spread;
+    segment(P, va, vb, len, f, &spread);
+    if (level < 3 && spread > 2e-3f) {
+        float tm = 0.5f * (ta + tb), vm = sample(P, add(p, mul(d, tm)));
+        segment_refined(P, p, d, ta, tm, va, vm, 0.5f * len, level + 1, D);
+        segment_refined(P, p, d, tm, tb, vm, vb, 0.5f * len, level + 1, D);
+        return;
+    }
+    for (int ch = 0; ch < 3; ++ch)
+        D[ch] += f[ch];
 }
 
 /* The exact reference's shadow ray: samples at the ends of steps of h from the point (the last
@@ -451,7 +474,6 @@ static v3 shadow(const prep *P, v3 p)
     int n_full = (int)floorf(len / h);
     float last = len - (float)n_full * h;
     double D[3] = {0, 0, 0};
-    float f[3];
     int skip = P->s->opts.empty_space_skipping, b[3];
     for (int k = 0; k <= n_full; ++k) {
         float ta_k = t_start + (float)k * h;
@@ -462,9 +484,7 @@ static v3 shadow(const prep *P, v3 p)
         v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
         if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
             continue;
-        segment(P, sample(P, qa), sample(P, qb), seg, f);
-        for (int ch = 0; ch < 3; ++ch)
-            D[ch] += f[ch];
+        segment_refined(P, p, d, ta_k, tb_k, sample(P, qa), sample(P, qb), seg, 0, D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
