@@ -394,7 +394,8 @@ static void depth_rate(const prep *P, const float c[4], float out[3])
 
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
  * the mean extinction over [v0, v1], split at the table's entries (or into 64 equal pieces if
- * it spans more), two-point Gauss per piece, as kernels/shadow_reference.cl. */
+ * it spans more), three-point Gauss per piece, as kernels/shadow_reference.cl; *spread: how
+ * much the extinction varies over the pieces' outer nodes, times len. */
 static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
     const int n = P->light_n;
@@ -420,14 +421,16 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3], 
                           : (j == np - 1 ? x1 : x0 + span * (float)(j + 1) / (float)np);
         if (!(b > a))
             continue;
-        float m = 0.5f * (a + b), hw = 0.28867513f * (b - a);
-        for (int q = -1; q <= 1; q += 2) {
+        float m = 0.5f * (a + b), hw = 0.38729833f * (b - a);
+        for (int q = -1; q <= 1; ++q) {
             lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
             depth_rate(P, c, r);
             for (int ch = 0; ch < 3; ++ch) {
-                out[ch] += 0.5f * (b - a) * r[ch];
-                lo = fminf(lo, r[ch]);
-                hi = fmaxf(hi, r[ch]);
+                out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
+                if (q) {
+                    lo = fminf(lo, r[ch]);
+                    hi = fmaxf(hi, r[ch]);
+                }
             }
         }
     }
@@ -436,17 +439,47 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3], 
     *spread = (hi - lo) * len;
 }
 
-/* segment, halved at a new sample (recursively, at most 3 times) while the extinction varies
- * along it by more than 2e-3 of optical depth, as kernels/shadow_reference.cl. */
-static void segment_refined(const prep *P, v3 p, v3 d, float ta, float tb, float va, float vb,
-                            float len, int level, double D[3])
+/* Where the ray x(t) = xo + t xd (voxel coordinates) crosses a plane of voxel centres inside the
+ * grid strictly within (ta, tb) (away from the ends by 1e-3 of the piece), the crossing nearest
+ * the middle over the three axes, or -1. */
+static float kink(const prep *P, const float xo[3], const float xd[3], float ta, float tb)
+{
+    float tm = 0.5f * (ta + tb), best = -1.0f;
+    for (int a = 0; a < 3; ++a) {
+        if (xd[a] == 0.0f)
+            continue;
+        float x0 = xo[a] + ta * xd[a], x1 = xo[a] + tb * xd[a];
+        float lo = fmaxf(fminf(x0, x1), 0.0f), hi = fminf(fmaxf(x0, x1), (float)(P->s->dims[a] - 1));
+        float c = rintf(xo[a] + tm * xd[a]);
+        c = c < ceilf(lo) ? ceilf(lo) : (c > floorf(hi) ? floorf(hi) : c);
+        if (!(c >= lo && c <= hi))
+            continue;
+        float t = (c - xo[a]) / xd[a], margin = 1e-3f * (tb - ta);
+        if (t > ta + margin && t < tb - margin && (best < 0.0f || fabsf(t - tm) < fabsf(best - tm)))
+            best = t;
+    }
+    return best;
+}
+
+/* segment, split at a new sample (recursively, at most 6 deep) as kernels/shadow_reference.cl:
+ * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-5 of
+ * optical depth, else at its middle if by more than 2e-3. */
+static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
+                            float ta, float tb, float va, float vb, float per_t, int level,
+                            double D[3])
 {
     float f[3], spread;
-    segment(P, va, vb, len, f, &spread);
-    if (level < 3 && spread > 2e-3f) {
-        float tm = 0.5f * (ta + tb), vm = sample(P, add(p, mul(d, tm)));
-        segment_refined(P, p, d, ta, tm, va, vm, 0.5f * len, level + 1, D);
-        segment_refined(P, p, d, tm, tb, vm, vb, 0.5f * len, level + 1, D);
+    segment(P, va, vb, (tb - ta) * per_t, f, &spread);
+    float tm = -1.0f;
+    if (level < 6 && spread > 1e-5f) {
+        tm = kink(P, xo, xd, ta, tb);
+        if (tm < 0.0f && spread > 2e-3f)
+            tm = 0.5f * (ta + tb);
+    }
+    if (tm >= 0.0f) {
+        float vm = sample(P, add(p, mul(d, tm)));
+        segment_refined(P, p, d, xo, xd, ta, tm, va, vm, per_t, level + 1, D);
+        segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, per_t, level + 1, D);
         return;
     }
     for (int ch = 0; ch < 3; ++ch)
@@ -474,6 +507,10 @@ static v3 shadow(const prep *P, v3 p)
     int n_full = (int)floorf(len / h);
     float last = len - (float)n_full * h;
     double D[3] = {0, 0, 0};
+    const float xo[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+                         (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+                         (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    const float xd[3] = {d.x * P->inv_spacing.x, d.y * P->inv_spacing.y, d.z * P->inv_spacing.z};
     int skip = P->s->opts.empty_space_skipping, b[3];
     for (int k = 0; k <= n_full; ++k) {
         float ta_k = t_start + (float)k * h;
@@ -484,7 +521,8 @@ static v3 shadow(const prep *P, v3 p)
         v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
         if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
             continue;
-        segment_refined(P, p, d, ta_k, tb_k, sample(P, qa), sample(P, qb), seg, 0, D);
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb),
+                        seg / (tb_k - ta_k), 0, D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
