@@ -20,7 +20,9 @@
  *  - an alpha = 1e-6 cloud over 512 voxels at steps 0.25, 0.05 and 0.01: 3e-7 (0.06% of the
  *    attenuation 5.1e-4);
  *  - random points in a small generated volume with structure (blobs and a shell, anisotropic
- *    spacing, coloured, directional and point light): FID_RANDOM_BOUND, and the mean error.
+ *    spacing, coloured, directional and point light): FID_RANDOM_BOUND, and the mean error;
+ *  - and, rendered: an alpha = 1 sphere's lit face equals the unshadowed image to 0.02, with and
+ *    without jitter (no speckles).
  * Each bound is also stated in the README ("Hard cases"). */
 #include <math.h>
 #include <stdio.h>
@@ -520,6 +522,97 @@ static void test_fidelity_random_points_structured_volume(void **state)
     fid_free(&S);
 }
 
+
+/* Issue 10, failure 5: opaque material lit from the front renders lit, without speckles. A
+ * sphere (radius 7 voxels, the value falling through 0.5 over 1.5 voxels at its surface) under a
+ * step transfer function of alpha 1, seen along -z with an ortho camera, lit from the camera's
+ * side; shading off, so a lit sample shows its colour times (ambient + light) exactly as
+ * unshadowed. On the pixels whose sphere point faces the light (N.L > 0.5, away from the
+ * silhouette) the reference image must match the unshadowed one to 0.02 per channel, with and
+ * without jitter: nothing lies between such a surface and the light. Before, the shadow was taken
+ * at the view sample, up to one view step behind the surface, and alpha 1 made any depth behind
+ * it black: the largest difference was 1.0, on about 700 of the 929 pixels. */
+static void test_fidelity_opaque_lit_surface_no_speckles(void **state)
+{
+    umbra_context ctx = *state;
+    enum { N = 24, W = 64 };
+    float *vox = malloc(N * N * N * sizeof *vox);
+    assert_non_null(vox);
+    for (int z = 0; z < N; ++z)
+        for (int y = 0; y < N; ++y)
+            for (int x = 0; x < N; ++x) {
+                double r = sqrt((x - 11.5) * (x - 11.5) + (y - 11.5) * (y - 11.5) +
+                                (z - 11.5) * (z - 11.5));
+                double v = 0.5 + (7.0 - r) / 1.5;
+                vox[((size_t)z * N + y) * N + x] = (float)(v < 0 ? 0 : (v > 1 ? 1 : v));
+            }
+    umbra_volume vol = test_volume(ctx, N, N, N, vox);
+    free(vox);
+    const umbra_light l = test_directional_light(-0.35f, -0.45f, -0.82f); /* toward +z camera */
+    const double ll = sqrt(0.35 * 0.35 + 0.45 * 0.45 + 0.82 * 0.82);
+    const double tl[3] = {0.35 / ll, 0.45 / ll, 0.82 / ll};
+    umbra_camera cam;
+    memset(&cam, 0, sizeof cam);
+    cam.projection = UMBRA_ORTHOGRAPHIC;
+    cam.eye[2] = 40.0f;
+    cam.up[1] = 1.0f;
+    cam.ortho_height = 20.0f;
+    const umbra_tf_point pts[4] = {{0.0f, {1, 1, 1, 0}},
+                                   {0.5f, {1, 1, 1, 0}},
+                                   {0.5f, {1, 1, 1, 1}},
+                                   {1.0f, {1, 1, 1, 1}}};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create_from_points(ctx, pts, 4, 256, &tf),
+                     UMBRA_SUCCESS);
+    float *none = malloc(W * W * 4 * sizeof *none), *ref = malloc(W * W * 4 * sizeof *ref);
+    assert_non_null(none);
+    assert_non_null(ref);
+    for (int jitter = 0; jitter < 2; ++jitter) {
+        umbra_render_desc o;
+        umbra_render_desc_init(&o);
+        o.jitter = jitter;
+        umbra_renderer r = test_renderer(ctx, vol, tf, &cam, &l, &o);
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_NONE;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_render(r, W, W, none), UMBRA_SUCCESS);
+        sd.technique = UMBRA_SHADOW_REFERENCE;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_render(r, W, W, ref), UMBRA_SUCCESS);
+        double worst = 0.0;
+        int checked = 0, bad = 0;
+        for (int py = 0; py < W; ++py)
+            for (int px = 0; px < W; ++px) {
+                /* the pixel's ray, and where it meets the sphere's value 0.5 (radius 7) */
+                double x = ((px + 0.5) / W * 2.0 - 1.0) * 10.0;
+                double y = (1.0 - (py + 0.5) / W * 2.0) * 10.0;
+                double rr = 49.0 - x * x - y * y;
+                if (rr < 4.0)
+                    continue;
+                double ndl = (x * tl[0] + y * tl[1] + sqrt(rr) * tl[2]) / 7.0;
+                if (ndl < 0.5)
+                    continue;
+                ++checked;
+                for (int c = 0; c < 3; ++c) {
+                    double e = fabs(ref[4 * (py * W + px) + c] - none[4 * (py * W + px) + c]);
+                    worst = fmax(worst, e);
+                    bad += e > 0.02;
+                }
+            }
+        print_message("  alpha 1, jitter %d: %d lit surface pixels, largest |reference - "
+                      "unshadowed| %.4f (bound 0.02), %d channels over it\n",
+                      jitter, checked, worst, bad);
+        assert_true(checked > 200);
+        assert_true(worst <= 0.02);
+        umbra_renderer_release(r);
+    }
+    umbra_transfer_function_release(tf);
+    free(none);
+    free(ref);
+    umbra_volume_release(vol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -528,6 +621,7 @@ int main(void)
         cmocka_unit_test(test_fidelity_near_singular_ramp),
         cmocka_unit_test(test_fidelity_thin_cloud_fine_steps),
         cmocka_unit_test(test_fidelity_random_points_structured_volume),
+        cmocka_unit_test(test_fidelity_opaque_lit_surface_no_speckles),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
