@@ -1,8 +1,8 @@
 /* tests/test_raycast.c: the foundation's ray caster and exact shadow reference, pinned down.
  *
  *  - the reference shadow factor in a homogeneous volume equals the analytic exp(-sigma d)
- *    (grey) or the shading model's per-step product (coloured), for many points, lights and
- *    reference steps, on isotropic and anisotropic grids;
+ *    (grey) or exp(-sigma d (1 - t_c)) (coloured), for many points, lights and reference steps,
+ *    on isotropic and anisotropic grids;
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
  *    pixel (<= 1e-4 per channel) and sample for sample;
  *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
@@ -250,10 +250,9 @@ static void test_reference_slab_matches_exp(void **state)
  * voxels, with an axis-aligned and an oblique light. Expected: exp(d log(1 - a)) in double.
  * Bounds: near-opaque, 1e-3 relative, or 1.5e-6 absolute where the shadow ray stops (it returns
  * 0 once the transmittance drops below 1e-6, kernels/shadow_reference.cl); near-transparent, 1% of
- * the attenuation 1 - T plus 2e-7. The transmittance is a float product (~2000 factors 1 - a/4
- * here), each factor held to half an ulp (3e-8): for a = 1e-5 that is 1% of its opacity and the
- * test uses 0.4 of its bound; at a = 1e-6 the attenuation is 4% off (an absolute 3e-7), which is
- * why 1e-5 is the smallest opacity asserted (README, "Hard cases"). */
+ * the attenuation 1 - T plus 2e-7. (Written when the transmittance was a float product, whose
+ * factors 1 - a/4 each lost half an ulp; since issue 10 the reference sums optical depths, and
+ * tests/test_fidelity.c holds a = 1e-6 over 512 voxels to 3e-7 at steps down to 0.01.) */
 static void test_reference_extreme_opacity_long_path(void **state)
 {
     umbra_context ctx = *state;
