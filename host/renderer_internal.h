@@ -69,7 +69,8 @@ struct umbra_renderer_t {
 
     /* device resources, re-created only when their inputs change */
     cl_mem frame_buf, shadow_buf, samples_buf;
-    cl_mem view_tf_buf, light_tf_buf;        /* view: alpha step-corrected; light: as given */
+    cl_mem view_tf_buf, light_tf_buf;        /* view: alpha step-corrected; light: as given,
+                                                then its interval depth sums (renderer.c) */
     cl_mem view_bricks_buf;                  /* uchar per brick: nonzero if visible (view) */
     cl_mem view_cells_buf, light_cells_buf;  /* ulong per brick: its visible sub-cells; a brick
                                               * is visible if any of them is */

@@ -8,15 +8,18 @@
  * sees the material between it and the face, which a midpoint rule misses for up to h/2). Along a
  * segment the value is taken to run linearly between its two end samples, and the segment's
  * optical depth is integrated through the transfer function in value space: the value interval
- * is split at the table's entries, where the interpolated opacity has its kinks, and each piece
- * takes a three-point Gauss rule of the extinction (at most SEG_MAX_PIECES pieces: a segment that
- * crosses more table entries is split into that many equal pieces). A sharp transfer-function edge
+ * is split at the table's entries, where the interpolated opacity has its kinks; the partial
+ * intervals at its ends take a three-point Gauss rule of the extinction, the whole ones between
+ * come from per-interval integrals the host computed in double (host/renderer.c, appended to the
+ * light table as compensated prefix sums). A sharp transfer-function edge
  * therefore costs no accuracy beyond the linearity of the value along one segment, and where the
  * extinction varies along a segment it is split further (segment_refined): at the interpolant's
  * kinks, then at its middle. A homogeneous medium gives exp(-sigma d) for every h. Measured
- * against an independent float64 integral (tests/test_fidelity.c) at h = 0.25: 1.3e-4 on a
- * one-voxel sheet under a step transfer function, 1.5e-7 on a near-singular ramp, 1.3e-4 at
- * random points in a structured volume. The depths are summed (Kahan-compensated) and exponentiated once, so a thin medium
+ * against an independent float64 integral (tests/test_fidelity.c) at h = 0.25: 1.4e-4 on a
+ * one-voxel sheet under a step transfer function, 5e-4 on a near-singular ramp, 1.8e-4 at
+ * random points in a structured volume. The refinement's thresholds trade that against time: at
+ * these the reference costs about 3-4x the midpoint rule's frame (Marschner-Lobb, 128^2, PoCL);
+ * splitting at every kink (1e-5) and to 2e-3 bought 1e-7 on the ramp for 10x. The depths are summed (Kahan-compensated) and exponentiated once, so a thin medium
  * keeps its precision at any step (1e-6 per voxel over 512 voxels at step 0.01). The march stops
  * once every channel is below 1e-6.
  *
@@ -28,18 +31,45 @@
 
 #define SHADOW_KERNEL_PARAMS
 
-/* The most value pieces one segment's depth is integrated over. */
-#define SEG_MAX_PIECES 64
-
 typedef struct ShadowRay {
     int unused;
 } ShadowRay;
 
 inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
+/* Gauss-Legendre over [a, b] (table units, within one table interval) of the extinction per
+ * light channel: the integral, and the range of the outer nodes' values into lo, hi. */
+inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, uint flags,
+                           float *lo, float *hi)
+{
+    const float last = (float)(n - 1);
+    const int i = min((int)a, (int)n - 2);
+    if (tf[i].w == 0.0f && tf[i + 1].w == 0.0f) { /* transparent: the common case, no logs */
+        *lo = 0.0f;
+        return (light_t)(0.0f);
+    }
+    const float m = 0.5f * (a + b), r = 0.38729833f * (b - a); /* nodes m, m -+ r */
+    const light_t s0 = light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags);
+    const light_t s1 = light_depth(tf_lookup(tf, n, m / last), 1.0f, flags);
+    const light_t s2 = light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags);
+    *lo = fmin(*lo, fmin(light_min(s0), light_min(s2)));
+    *hi = fmax(*hi, fmax(light_max(s0), light_max(s2)));
+    return ((b - a) / 18.0f) * (5.0f * s0 + 8.0f * s1 + 5.0f * s2);
+}
+
+/* The sum of the interval depths of the table's entries [0, k) (host/renderer.c, after the n
+ * entries: hi at n + 2k, lo at n + 2k + 1), per light channel. */
+inline float4 interval_sum(__global const float4 *tf, uint n, int k, int j)
+{
+    const float4 hi = tf[n + 2 * j] - tf[n + 2 * k], lo = tf[n + 2 * j + 1] - tf[n + 2 * k + 1];
+    return hi + lo;
+}
+
 /* The optical depth per light channel of a segment of len voxels along which the value runs
  * linearly from v0 to v1: len times the mean extinction over [v0, v1] of the light table
- * (n entries). */
+ * (n entries): the partial table intervals at the ends by three-point Gauss, the whole ones
+ * between from the host's exact interval sums. *spread: how much the extinction varies over the
+ * range (the Gauss nodes and the whole intervals' mean), times len. */
 inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float v1, float len,
                              uint flags, float *spread)
 {
@@ -51,28 +81,25 @@ inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float 
     if (!(span > 0.0f))
         return light_depth(tf_lookup(tf, n, x0 / last), len, flags);
     const int i0 = min((int)x0, (int)n - 2), i1 = min((int)x1, (int)n - 2);
-    const int aligned = i1 - i0 < SEG_MAX_PIECES;
-    const int np = aligned ? i1 - i0 + 1 : SEG_MAX_PIECES;
-    light_t sum = (light_t)(0.0f);
     float lo = UMBRA_INF, hi = 0.0f;
-    for (int j = 0; j < np; ++j) {
-        float a, b;
-        if (aligned) {
-            a = fmax(x0, (float)(i0 + j));
-            b = fmin(x1, (float)(i0 + j + 1));
-        } else {
-            a = x0 + span * (float)j / (float)np;
-            b = j == np - 1 ? x1 : x0 + span * (float)(j + 1) / (float)np;
+    light_t sum;
+    if (i0 == i1) {
+        sum = piece_depth(tf, n, x0, x1, flags, &lo, &hi);
+    } else {
+        sum = piece_depth(tf, n, x0, (float)(i0 + 1), flags, &lo, &hi) +
+              piece_depth(tf, n, (float)i1, x1, flags, &lo, &hi);
+        if (i1 > i0 + 1) {
+            const float4 w = interval_sum(tf, n, i0 + 1, i1);
+#if UMBRA_LIGHT_CHANNELS == 1
+            const light_t whole = (flags & UMBRA_FLAG_COLORED) ? w.x : w.w;
+#else
+            const light_t whole = (flags & UMBRA_FLAG_COLORED) ? w.xyz : (float3)(w.w);
+#endif
+            sum += whole;
+            const light_t mean = whole / (float)(i1 - i0 - 1);
+            lo = fmin(lo, light_min(mean));
+            hi = fmax(hi, light_max(mean));
         }
-        if (!(b > a))
-            continue;
-        const float m = 0.5f * (a + b), r = 0.38729833f * (b - a); /* Gauss nodes m, m -+ r */
-        const light_t s0 = light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags);
-        const light_t s1 = light_depth(tf_lookup(tf, n, m / last), 1.0f, flags);
-        const light_t s2 = light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags);
-        sum += ((b - a) / 18.0f) * (5.0f * s0 + 8.0f * s1 + 5.0f * s2);
-        lo = fmin(lo, fmin(light_min(s0), light_min(s2)));
-        hi = fmax(hi, fmax(light_max(s0), light_max(s2)));
     }
     *spread = (hi - lo) * len;
     return sum * (len / span);
@@ -119,9 +146,9 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
  *    and a value linear in space along an axis is integrated exactly;
  *  - else, where it varies by more than SEG_REFINE_DEPTH (the interpolant's curvature, an error
  *    of second order), at the middle. */
-#define SEG_REFINE_LEVELS 6
-#define SEG_REFINE_DEPTH 2e-3f
-#define SEG_KINK_DEPTH 1e-5f
+#define SEG_REFINE_LEVELS 3
+#define SEG_REFINE_DEPTH 4e-3f
+#define SEG_KINK_DEPTH 1e-3f
 inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
                                uint flags, float3 p, float3 d, float3 xo, float3 xd, float ta,
                                float tb, float va, float vb, float len)

@@ -31,8 +31,8 @@
 
 #include "test_util.h"
 
-/* Measured at step 0.25 (PoCL): sheet 4.2e-4, ramp 3.9e-4, structured volume 7.1e-5 (mean
- * 3.8e-6). Before issue 10 (midpoint rule, product of per-step factors): 0.58, 0.116, 5.6e-3. */
+/* Measured at step 0.25 (PoCL): sheet 1.4e-4, ramp 5.0e-4, structured volume 1.8e-4 (mean
+ * 5.3e-6). Before issue 10 (midpoint rule, product of per-step factors): 0.56, 1.8e-2, 4.3e-2. */
 #define FID_SHEET_BOUND 1e-3
 #define FID_RAMP_BOUND 1e-3
 #define FID_RANDOM_BOUND 3e-4

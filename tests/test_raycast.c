@@ -4,7 +4,8 @@
  *    (grey) or exp(-sigma d (1 - t_c)) (coloured), for many points, lights and reference steps,
  *    on isotropic and anisotropic grids;
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
- *    pixel (<= 1e-4 per channel) and sample for sample;
+ *    pixel (<= 1e-4 per channel; with the exact reference's adaptive shadow rays <= 1e-3, and
+ *    at most 0.5% of values over 1e-4) and sample for sample;
  *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
  *    edge cases (odd brick sizes, rays running in cell faces);
  *  - an application's own cl_context / device / queue work and are left as they were found;
@@ -430,9 +431,19 @@ static void test_raycast_matches_cpu_reference(void **state)
                       c->ortho ? "ortho" : "persp", c->point_light ? "point" : "dir  ",
                       c->colored ? "coloured" : "grey    ", umbra_shadow_technique_name(c->technique),
                       err, (unsigned long long)stats.samples, (unsigned long long)samples);
-        if (err > 1e-4)
-            fail_msg("case %zu: pixel (%zu, %zu) channel %zu: umbra %.7f, cpu %.7f", i,
-                     (at / 4) % RC_W, (at / 4) / RC_W, at % 4, gpu[at], cpu[at]);
+        /* 1e-4 per channel. With the exact reference, 1e-3 at a few values: its shadow rays
+         * refine a segment where the extinction along it varies by more than a threshold
+         * (kernels/shadow_reference.cl), and float rounding that differs between the two can
+         * put a segment on either side of it, which moves that ray's value by up to the
+         * refinement's own tolerance; at most 0.5% of the values may differ by more than 1e-4. */
+        size_t over = 0;
+        for (size_t k = 0; k < (size_t)RC_W * RC_H * 4; ++k)
+            over += fabs((double)gpu[k] - cpu[k]) > 1e-4;
+        const int refined = c->technique == UMBRA_SHADOW_REFERENCE;
+        if (err > (refined ? 1e-3 : 1e-4) || (double)over > 0.005 * RC_W * RC_H * 4)
+            fail_msg("case %zu: pixel (%zu, %zu) channel %zu: umbra %.7f, cpu %.7f (%zu values "
+                     "over 1e-4)", i, (at / 4) % RC_W, (at / 4) / RC_W, at % 4, gpu[at], cpu[at],
+                     over);
         assert_true(stats.samples > 0);
         assert_int_equal(stats.samples, samples);
         free(voxels);

@@ -32,6 +32,8 @@ typedef struct prep {
     float *view_tf, *light_tf;    /* alpha corrected for the view step / as given (light) */
     int view_n, light_n;
     unsigned char *light_bricks;  /* per brick, visible to the light transfer function */
+    double *light_int;            /* per light table interval: the integral of the extinction
+                                     times 1 - t (r, g, b) and times 1 (grey), table units */
     uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
     int nb[3], B, C;              /* bricks per axis, brick edge, sub-cell edge (voxels) */
     float step, shadow_step;
@@ -319,6 +321,25 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->light_tf = corrected(ltf, P->light_n, 0.0f);
     P->view_cells = cells(P, s->tf, s->tf_count);
     P->light_bricks = bricks(P, ltf, P->light_n);
+    P->light_int = malloc((size_t)4 * (P->light_n - 1) * sizeof *P->light_int);
+    if (P->light_int)
+        for (int i = 0; i + 1 < P->light_n; ++i) {
+            /* composite three-point Gauss over 16 pieces, in double */
+            static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+            static const double gw[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+            double *o = P->light_int + 4 * i;
+            o[0] = o[1] = o[2] = o[3] = 0.0;
+            for (int q = 0; q < 48; ++q) {
+                double w = (q / 3 + 0.5 + 0.5 * gx[q % 3]) / 16.0, c[4];
+                for (int k = 0; k < 4; ++k)
+                    c[k] = ltf[4 * i + k] + w * (ltf[4 * i + 4 + k] - ltf[4 * i + k]);
+                double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
+                double sg = -log1p(-a) * gw[q % 3] / 16.0;
+                for (int k = 0; k < 3; ++k)
+                    o[k] += sg * (1.0 - c[k]);
+                o[3] += sg;
+            }
+        }
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
     P->point = s->light.type == UMBRA_LIGHT_POINT;
     P->light_vec = P->point ? from(s->light.position) : norm(from(s->light.direction));
@@ -330,6 +351,7 @@ static void prep_free(prep *P)
     free(P->light_tf);
     free(P->view_cells);
     free(P->light_bricks);
+    free(P->light_int);
 }
 
 /* The interval [*t0, *t1] of o + t d inside the box; *t1 < *t0 when the ray misses. */
@@ -392,10 +414,37 @@ static void depth_rate(const prep *P, const float c[4], float out[3])
         out[ch] = sigma * (P->colored ? 1.0f - c[ch] : 1.0f);
 }
 
+/* Three-point Gauss over [a, b] (table units, within one interval) of the extinction rate per
+ * channel, added to out; lo, hi take the outer nodes' range. A transparent interval adds 0 and
+ * sets lo to 0, as the kernel does. */
+static void piece(const prep *P, float a, float b, double out[3], float *lo, float *hi)
+{
+    const int n = P->light_n;
+    const float last = (float)(n - 1);
+    int i = (int)a < n - 2 ? (int)a : n - 2;
+    if (P->light_tf[4 * i + 3] == 0.0f && P->light_tf[4 * i + 7] == 0.0f) {
+        *lo = 0.0f;
+        return;
+    }
+    float m = 0.5f * (a + b), hw = 0.38729833f * (b - a), c[4], r[3];
+    for (int q = -1; q <= 1; ++q) {
+        lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
+        depth_rate(P, c, r);
+        for (int ch = 0; ch < 3; ++ch) {
+            out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
+            if (q) {
+                *lo = fminf(*lo, r[ch]);
+                *hi = fmaxf(*hi, r[ch]);
+            }
+        }
+    }
+}
+
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
- * the mean extinction over [v0, v1], split at the table's entries (or into 64 equal pieces if
- * it spans more), three-point Gauss per piece, as kernels/shadow_reference.cl; *spread: how
- * much the extinction varies over the pieces' outer nodes, times len. */
+ * the mean extinction over [v0, v1]: the partial table intervals at the ends by three-point
+ * Gauss, the whole ones between from their integrals (light_int), as kernels/shadow_reference.cl;
+ * *spread: the range of the extinction over the Gauss nodes and the whole intervals' mean,
+ * times len. */
 static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
     const int n = P->light_n;
@@ -404,7 +453,7 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3], 
     float x1 = clampf(v0 < v1 ? v1 : v0, 0.0f, 1.0f) * last;
     float span = x1 - x0, c[4], r[3];
     float lo = INFINITY, hi = 0.0f;
-    out[0] = out[1] = out[2] = 0.0f;
+    double sum[3] = {0, 0, 0};
     *spread = 0.0f;
     if (!(span > 0.0f)) {
         lookup(P->light_tf, n, x0 / last, c);
@@ -414,28 +463,27 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3], 
         return;
     }
     int i0 = (int)x0 < n - 2 ? (int)x0 : n - 2, i1 = (int)x1 < n - 2 ? (int)x1 : n - 2;
-    int aligned = i1 - i0 < 64, np = aligned ? i1 - i0 + 1 : 64;
-    for (int j = 0; j < np; ++j) {
-        float a = aligned ? fmaxf(x0, (float)(i0 + j)) : x0 + span * (float)j / (float)np;
-        float b = aligned ? fminf(x1, (float)(i0 + j + 1))
-                          : (j == np - 1 ? x1 : x0 + span * (float)(j + 1) / (float)np);
-        if (!(b > a))
-            continue;
-        float m = 0.5f * (a + b), hw = 0.38729833f * (b - a);
-        for (int q = -1; q <= 1; ++q) {
-            lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
-            depth_rate(P, c, r);
+    if (i0 == i1) {
+        piece(P, x0, x1, sum, &lo, &hi);
+    } else {
+        piece(P, x0, (float)(i0 + 1), sum, &lo, &hi);
+        piece(P, (float)i1, x1, sum, &lo, &hi);
+        if (i1 > i0 + 1) {
+            double whole[4] = {0, 0, 0, 0};
+            for (int i = i0 + 1; i < i1; ++i)
+                for (int k = 0; k < 4; ++k)
+                    whole[k] += P->light_int[4 * i + k];
             for (int ch = 0; ch < 3; ++ch) {
-                out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
-                if (q) {
-                    lo = fminf(lo, r[ch]);
-                    hi = fmaxf(hi, r[ch]);
-                }
+                double w = P->colored ? whole[ch] : whole[3];
+                sum[ch] += w;
+                float mean = (float)(w / (i1 - i0 - 1));
+                lo = fminf(lo, mean);
+                hi = fmaxf(hi, mean);
             }
         }
     }
     for (int ch = 0; ch < 3; ++ch)
-        out[ch] *= len / span;
+        out[ch] = (float)(sum[ch] * (len / span));
     *spread = (hi - lo) * len;
 }
 
@@ -461,9 +509,9 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
     return best;
 }
 
-/* segment, split at a new sample (recursively, at most 6 deep) as kernels/shadow_reference.cl:
- * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-5 of
- * optical depth, else at its middle if by more than 2e-3. */
+/* segment, split at a new sample (recursively, at most 3 deep) as kernels/shadow_reference.cl:
+ * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-3 of
+ * optical depth, else at its middle if by more than 4e-3. */
 static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
                             float ta, float tb, float va, float vb, float per_t, int level,
                             double D[3])
@@ -471,9 +519,9 @@ static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const 
     float f[3], spread;
     segment(P, va, vb, (tb - ta) * per_t, f, &spread);
     float tm = -1.0f;
-    if (level < 6 && spread > 1e-5f) {
+    if (level < 3 && spread > 1e-3f) {
         tm = kink(P, xo, xd, ta, tb);
-        if (tm < 0.0f && spread > 2e-3f)
+        if (tm < 0.0f && spread > 4e-3f)
             tm = 0.5f * (ta + tb);
     }
     if (tm >= 0.0f) {
@@ -702,7 +750,7 @@ cpu_prepared *cpu_prepare(const cpu_scene *s)
     if (!p)
         return NULL;
     prep_init(&p->P, s);
-    if (!p->P.view_tf || !p->P.light_tf || !p->P.light_bricks ||
+    if (!p->P.view_tf || !p->P.light_tf || !p->P.light_bricks || !p->P.light_int ||
         !p->P.view_cells) {
         cpu_prepared_free(p);
         return NULL;
