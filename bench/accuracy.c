@@ -1220,7 +1220,7 @@ static void headline_table(const bench_run *B, FILE *f, int si)
                      umbra_shadow_technique_name(any->cfg.desc.technique), any->cfg.label);
         char u[32] = "–";
         if (nu)
-            snprintf(u, sizeof u, "%.4f", ru / nu);
+            snprintf(u, sizeof u, "%.1e", ru / nu);
         fprintf(f, "| %s | %s | %s | %.4f | %s | %.4f | %s | %s |", name, o, b, rm / n, u, ss / n, m,
                 sp);
         if (si < 0)
@@ -1325,7 +1325,7 @@ static void write_summary(bench_run *B)
                 const result *r = &B->results[k];
                 if (r->ref_unc.rmse >= 0.0)
                     fprintf(f, "The reference's own uncertainty (its step %g against half of it): "
-                               "RMSE %.4f, max %.3f; column \"ref ±\" below.\n\n",
+                               "RMSE %.1e, max %.1e; column \"ref ±\" below.\n\n",
                             r->cfg.desc.technique == UMBRA_SHADOW_REFERENCE
                                 ? r->cfg.desc.reference_step
                                 : exact_step(spec),
@@ -1358,7 +1358,7 @@ static void write_summary(bench_run *B)
                 snprintf(runs, sizeof runs, "%d", r->runs ? r->runs : 1);
             char unc_s[32] = "–";
             if (r->ref_unc.rmse >= 0.0)
-                snprintf(unc_s, sizeof unc_s, "%.4f", r->ref_unc.rmse);
+                snprintf(unc_s, sizeof unc_s, "%.1e", r->ref_unc.rmse);
             fprintf(f, "| %s | %s | %s | %s | %s | %s | %s | %u | %.4f | %s | %s | %.3f | %.4f | "
                        "%s | %s | %s |\n",
                     umbra_shadow_technique_name(r->cfg.desc.technique), r->cfg.label, b, rd, ov,
