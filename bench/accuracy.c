@@ -286,6 +286,9 @@ typedef struct result {
     metrics_error err;
     uint32_t width, height;
     int pareto_time, pareto_memory;
+    /* The yardstick's own error: the scene's reference at its step against the reference at half
+     * that step (display values, as err); rmse < 0 when it could not be measured. */
+    metrics_error ref_unc;
 } result;
 
 typedef struct note_list {
@@ -598,7 +601,8 @@ static outcome reference_image(bench_run *B, scene_ctx *S, int si, const config 
 {
     const scene_spec *spec = &B->scenes[si];
     uint64_t key = spec->hash;
-    const char *tag = "umbra-bench accuracy reference v1";
+    /* v2: the extinction model and segment quadrature of issue 10 */
+    const char *tag = "umbra-bench accuracy reference v2";
     key = scene_hash_bytes(key, tag, strlen(tag));
     key = scene_hash_bytes(key, &S->width, sizeof S->width);
     key = scene_hash_bytes(key, &S->height, sizeof S->height);
@@ -809,10 +813,27 @@ static void run_scene(bench_run *B, int si)
     exact->render_ms = exact->total_ms = exact->render_min = exact->render_max = ref_ms;
     exact->reference_ms = ref_ms;
     exact->reference_cached = cached;
+    exact->ref_unc.rmse = -1.0;
     exact->channels = 0;
     exact->width = S.width;
     exact->height = S.height;
     metrics_compare(ref, ref, S.width, S.height, &exact->err);
+
+    /* The reference's uncertainty: the same reference at half its step (cached alike). */
+    metrics_error unc = {-1.0, 0.0, 0.0, 0.0, 0.0};
+    {
+        config half = L.items[0];
+        half.desc.reference_step *= 0.5f;
+        double half_ms = 0.0;
+        int half_cached = 0;
+        if (reference_image(B, &S, si, &half, scratch, &half_ms, &half_cached) == MEASURED &&
+            metrics_compare(scratch, ref, S.width, S.height, &unc) == 0)
+            fprintf(stderr, "accuracy: %s: reference at step %g vs %g: RMSE %.5f, max %.4f\n",
+                    spec->name, L.items[0].desc.reference_step, half.desc.reference_step,
+                    unc.rmse, unc.max_abs);
+        else
+            unc.rmse = -1.0;
+    }
 
     double none_ms = 0.0;
     for (int i = 1; i < L.count; ++i) {
@@ -854,6 +875,7 @@ static void run_scene(bench_run *B, int si)
     /* B->results may have moved: fill the per-scene columns now. */
     for (int k = first_row; k < B->result_count; ++k) {
         B->results[k].none_ms = none_ms;
+        B->results[k].ref_unc = unc;
         /* The exact reference simulates as many channels as the coarser ones measured. */
         if (B->results[k].cfg.desc.technique == UMBRA_SHADOW_REFERENCE)
             B->results[first_row].channels = B->results[k].channels;
@@ -946,7 +968,7 @@ static const char *const csv_columns[] = {
     "total_ms", "build_ms_min", "build_ms_max", "render_ms_min", "render_ms_max", "none_render_ms",
     "render_overhead", "build_over_frame", "reference_ms", "speedup_vs_reference", "memory_bytes",
     "light_channels", "slices", "samples", "rmse", "psnr_db", "max_abs", "mean_abs", "ssim",
-    "pareto_time", "pareto_memory",
+    "pareto_time", "pareto_memory", "reference_half_step_rmse", "reference_half_step_max_abs",
 };
 
 static int csv_column(const char *name)
@@ -995,8 +1017,12 @@ static void write_csv(bench_run *B)
             fprintf(f, "inf,");
         else
             fprintf(f, "%.3f,", r->err.psnr_db);
-        fprintf(f, "%.6g,%.6g,%.6f,%d,%d\n", r->err.max_abs, r->err.mean_abs, r->err.ssim,
+        fprintf(f, "%.6g,%.6g,%.6f,%d,%d,", r->err.max_abs, r->err.mean_abs, r->err.ssim,
                 r->pareto_time, r->pareto_memory);
+        if (r->ref_unc.rmse >= 0.0)
+            fprintf(f, "%.6g,%.6g\n", r->ref_unc.rmse, r->ref_unc.max_abs);
+        else
+            fprintf(f, ",\n");
     }
     fclose(f);
 }
@@ -1141,12 +1167,12 @@ static void fmt_ratio(double x, char *buf, size_t size)
 static void headline_table(const bench_run *B, FILE *f, int si)
 {
     fprintf(f, "| technique | render overhead over unshadowed | map build / unshadowed frame | "
-               "RMSE | SSIM | memory | speed-up over exact reference |%s\n"
-               "|---|---|---|---|---|---|---|%s\n", si < 0 ? " scenes |" : "",
+               "RMSE | reference's own RMSE | SSIM | memory | speed-up over exact reference |%s\n"
+               "|---|---|---|---|---|---|---|---|%s\n", si < 0 ? " scenes |" : "",
             si < 0 ? "---|" : "");
     for (int h = H_NONE; h < H_COUNT; ++h) {
-        double lo = 0, lb = 0, rm = 0, ss = 0, lmem = 0, lsp = 0;
-        int n = 0, nb = 0, nmem = 0;
+        double lo = 0, lb = 0, rm = 0, ss = 0, lmem = 0, lsp = 0, ru = 0;
+        int n = 0, nb = 0, nmem = 0, nu = 0;
         const result *any = NULL;
         for (int s = 0; s < B->scene_count; ++s) {
             if (si >= 0 && s != si)
@@ -1160,6 +1186,10 @@ static void headline_table(const bench_run *B, FILE *f, int si)
                 ++nb;
             }
             rm += r->err.rmse;
+            if (r->ref_unc.rmse >= 0.0) {
+                ru += r->ref_unc.rmse;
+                ++nu;
+            }
             ss += r->err.ssim;
             if (r->memory > 0) {
                 lmem += log((double)r->memory);
@@ -1188,7 +1218,11 @@ static void headline_table(const bench_run *B, FILE *f, int si)
         else
             snprintf(name, sizeof name, "%s, %s",
                      umbra_shadow_technique_name(any->cfg.desc.technique), any->cfg.label);
-        fprintf(f, "| %s | %s | %s | %.4f | %.4f | %s | %s |", name, o, b, rm / n, ss / n, m, sp);
+        char u[32] = "–";
+        if (nu)
+            snprintf(u, sizeof u, "%.1e", ru / nu);
+        fprintf(f, "| %s | %s | %s | %.4f | %s | %.4f | %s | %s |", name, o, b, rm / n, u, ss / n, m,
+                sp);
         if (si < 0)
             fprintf(f, " %d |", n);
         fprintf(f, "\n");
@@ -1233,7 +1267,10 @@ static void write_headline(bench_run *B)
     fprintf(f, "\nRender overhead: render time with shadows over the unshadowed render of the same "
                "view; build: the shadow structure's construction over one unshadowed frame (paid "
                "when the light or the transfer function changes); RMSE and SSIM against the "
-               "exact reference (display values, `bench/metrics.h`); speed-up: the exact "
+               "exact reference (display values, `bench/metrics.h`); the reference's own RMSE: "
+               "the exact reference at its step against the exact reference at half that step, "
+               "the yardstick's uncertainty (an RMSE near it is not a measured error); speed-up: "
+               "the exact "
                "reference's render time over build + render. Device: %s. %s.\n",
             B->device, B->started);
     fclose(f);
@@ -1283,9 +1320,23 @@ static void write_summary(bench_run *B)
         fprintf(f, "![error vs time](plots/%s-error-vs-time.png) "
                    "![error vs memory](plots/%s-error-vs-memory.png)\n\n", spec->name,
                 spec->name);
+        for (int k = 0; k < B->result_count; ++k)
+            if (B->results[k].scene == si) {
+                const result *r = &B->results[k];
+                if (r->ref_unc.rmse >= 0.0)
+                    fprintf(f, "The reference's own uncertainty (its step %g against half of it): "
+                               "RMSE %.1e, max %.1e; column \"ref ±\" below.\n\n",
+                            r->cfg.desc.technique == UMBRA_SHADOW_REFERENCE
+                                ? r->cfg.desc.reference_step
+                                : exact_step(spec),
+                            r->ref_unc.rmse, r->ref_unc.max_abs);
+                else
+                    fprintf(f, "The reference's own uncertainty could not be measured.\n\n");
+                break;
+            }
         fprintf(f, "| technique | setting | build ms | render ms | overhead | build/frame | "
-                   "memory | ch | RMSE | PSNR dB | max | SSIM | speed-up | runs | front |\n"
-                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                   "memory | ch | RMSE | ref ± | PSNR dB | max | SSIM | speed-up | runs | front |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (int k = 0; k < B->result_count; ++k) {
             const result *r = &B->results[k];
             if (r->scene != si)
@@ -1305,10 +1356,14 @@ static void write_summary(bench_run *B)
                 snprintf(runs, sizeof runs, "cached");
             else
                 snprintf(runs, sizeof runs, "%d", r->runs ? r->runs : 1);
-            fprintf(f, "| %s | %s | %s | %s | %s | %s | %s | %u | %.4f | %s | %.3f | %.4f | %s | "
-                       "%s | %s |\n",
+            char unc_s[32] = "–";
+            if (r->ref_unc.rmse >= 0.0)
+                snprintf(unc_s, sizeof unc_s, "%.1e", r->ref_unc.rmse);
+            fprintf(f, "| %s | %s | %s | %s | %s | %s | %s | %u | %.4f | %s | %s | %.3f | %.4f | "
+                       "%s | %s | %s |\n",
                     umbra_shadow_technique_name(r->cfg.desc.technique), r->cfg.label, b, rd, ov,
-                    bf, mem, r->channels, r->err.rmse, psnr, r->err.max_abs, r->err.ssim, sp, runs,
+                    bf, mem, r->channels, r->err.rmse, unc_s, psnr, r->err.max_abs, r->err.ssim,
+                    sp, runs,
                     r->pareto_time ? (r->pareto_memory ? "time, memory" : "time")
                                    : (r->pareto_memory ? "memory" : ""));
         }

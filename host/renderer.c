@@ -455,22 +455,68 @@ float umbra__voxel_world(umbra_renderer r)
     return fminf(s[0], fminf(s[1], s[2]));
 }
 
+/* The integral over table interval i (from entry i to i + 1, in table units) of the extinction
+ * -ln(1 - a) (a at most 1 - 2^-24, kernels/common.cl) times 1 - t_c for c = r, g, b and times 1
+ * (grey), the entries interpolated linearly: composite three-point Gauss in double over 16
+ * pieces, which resolves the log's curvature up to the clamp. */
+static void interval_depths(const float *e, double out[4])
+{
+    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+    static const double weight[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+    out[0] = out[1] = out[2] = out[3] = 0.0;
+    for (int piece = 0; piece < 16; ++piece)
+        for (int q = 0; q < 3; ++q) {
+            double w = (piece + 0.5 + 0.5 * node[q]) / 16.0, c[4];
+            for (int k = 0; k < 4; ++k)
+                c[k] = e[k] + w * (e[4 + k] - e[k]);
+            double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
+            double sigma = -log1p(-a) * weight[q] / 16.0;
+            for (int k = 0; k < 3; ++k)
+                out[k] += sigma * (1.0 - c[k]);
+            out[3] += sigma;
+        }
+}
+
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
  * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
- * alpha_for_length in kernels/common.cl). */
+ * alpha_for_length in kernels/common.cl). step_voxels 0 makes the light table: the alphas as
+ * given (kernels convert the interpolated alpha to extinction per sample, kernels/common.cl),
+ * followed by 2 count float4: for each entry k, the sum over the intervals before it of
+ * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
+ * from which the exact reference takes the depth of whole table intervals with two loads and no
+ * cancellation (kernels/shadow_reference.cl). */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    size_t bytes = (size_t)tf->count * 4 * sizeof(float);
+    const int light = step_voxels == 0.0f;
+    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 3 : 1);
     float *t = malloc(bytes);
     if (!t)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
     for (uint32_t i = 0; i < tf->count; ++i) {
         memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
         double a = tf->rgba[4 * i + 3];
-        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
+        t[4 * i + 3] = light ? (float)a
+                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                 : 1.0f;
+    }
+    if (light) {
+        double sum[4] = {0, 0, 0, 0}, d[4];
+        float *p = t + 4 * (size_t)tf->count;
+        for (uint32_t k = 0; k < tf->count; ++k) {
+            for (int c = 0; c < 4; ++c) {
+                float hi = (float)sum[c];
+                p[8 * k + c] = hi;
+                p[8 * k + 4 + c] = (float)(sum[c] - (double)hi);
+            }
+            if (k + 1 < tf->count) {
+                interval_depths(tf->rgba + 4 * k, d);
+                for (int c = 0; c < 4; ++c)
+                    sum[c] += d[c];
+            }
+        }
     }
     release_mem(buf);
     cl_int err;
@@ -562,9 +608,9 @@ static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float s
     return st;
 }
 
-umbra_status umbra__light_tables(umbra_renderer r, float step_voxels)
+umbra_status umbra__light_tables(umbra_renderer r)
 {
-    return tables(r, umbra__light_tf(r), step_voxels, r->light_tf_key, &r->light_tf_buf, NULL,
+    return tables(r, umbra__light_tf(r), 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
                   &r->light_cells_buf);
 }
 
@@ -803,7 +849,7 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     if (r->tech->id != UMBRA_SHADOW_NONE &&
         (st = check_ray_samples(r, light_step, what, "umbra_renderer_render")) != UMBRA_SUCCESS)
         return st;
-    st = umbra__light_tables(r, light_step);
+    st = umbra__light_tables(r);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__light_key key;

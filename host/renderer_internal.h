@@ -77,7 +77,8 @@ struct umbra_renderer_t {
 
     /* device resources, re-created only when their inputs change */
     cl_mem frame_buf, shadow_buf, samples_buf;
-    cl_mem view_tf_buf, light_tf_buf;        /* tables with step-corrected alpha */
+    cl_mem view_tf_buf, light_tf_buf;        /* view: alpha step-corrected; light: as given,
+                                                then its interval depth sums (renderer.c) */
     cl_mem view_bricks_buf;                  /* uchar per brick: nonzero if visible (view) */
     cl_mem view_cells_buf, light_cells_buf;  /* ulong per brick: its visible sub-cells; a brick
                                               * is visible if any of them is */
@@ -154,9 +155,10 @@ float umbra__voxel_world(umbra_renderer r);
  * render time). Techniques may rely on it during build. */
 void umbra__frame_update_light(umbra_renderer r);
 
-/* Makes sure r->light_tf_buf holds the light table corrected for step_voxels and
- * r->light_cells_buf the visibility of each brick's sub-cells under it. */
-umbra_status umbra__light_tables(umbra_renderer r, float step_voxels);
+/* Makes sure r->light_tf_buf holds the light table (alphas as given: the kernels correct per
+ * sample, kernels/common.cl) and r->light_cells_buf the visibility of each brick's sub-cells
+ * under it. */
+umbra_status umbra__light_tables(umbra_renderer r);
 
 /* Marks the point in a frame after which commands must wait for an asynchronous frame's wait
  * list (a no-op for blocking frames): the renderer or technique calls it once, after everything

@@ -219,6 +219,7 @@ static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
     UMBRA_CL(clSetKernelArg(s->k_lut, 0, sizeof(cl_mem), &r->frame_buf));
     UMBRA_CL(clSetKernelArg(s->k_lut, 1, sizeof(cl_mem), &r->light_tf_buf));
     UMBRA_CL(clSetKernelArg(s->k_lut, 2, sizeof(cl_mem), &s->lut));
+    UMBRA_CL(clSetKernelArg(s->k_lut, 3, sizeof step, &step)); /* the segment, in voxels */
     size_t global[2] = {UMBRA__DEEP_LUT_RES, UMBRA__DEEP_LUT_RES};
     if ((st = run_kernel(r, s->k_lut, global, NULL, ms)) != UMBRA_SUCCESS)
         goto fail;

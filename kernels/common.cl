@@ -335,33 +335,65 @@ inline float4 to_light(__global const UmbraFrame *F, float3 p)
 }
 
 /* ---- the shading model's light transport ------------------------------------------------------
- * A sample of step-corrected opacity a and transmission colour t passes the fraction
- * 1 - a (1 - t_c) of light channel c; t = 0 unless UMBRA_FLAG_COLORED, where t is the light
- * transfer function's RGB. UMBRA_LIGHT_CHANNELS = 1 is chosen by the host when t is the same in
- * all channels wherever a > 0 (grey mode, or a grey light transfer function): then one channel
- * carries the light, and its value stands for all three. */
+ * Light is absorbed per channel with extinction sigma_c = sigma (1 - t_c), where sigma =
+ * -ln(1 - a) per voxel length is the extinction of the light transfer function's opacity a (the
+ * table's alpha, linearly interpolated first, then converted: include/umbra/transfer_function.h)
+ * and t = 0 unless UMBRA_FLAG_COLORED, where t is the light transfer function's RGB. A length of
+ * D voxels at one value therefore passes (1 - a)^(D (1 - t_c)) of channel c: exact for every D in a
+ * homogeneous medium, so every technique's result is independent of its step there. (The CSSM
+ * paper's rho = a (1 - t) is the one-sample form of this, first order in the step.) Opacity 1 is
+ * taken as the largest float below 1 (UMBRA_ALPHA_MAX, an extinction of 16.6 per voxel): a float
+ * table cannot tell them apart, and a finite extinction keeps the light of a point on an opaque
+ * surface, whose shadow ray crosses the material only for a rounding error's length, at 1 rather
+ * than at 0 or at 1 by the chance of that rounding (black speckles on lit opaque faces).
+ * UMBRA_LIGHT_CHANNELS = 1 is chosen by the host when t is the same in all channels wherever a > 0
+ * (grey mode, or a grey light transfer function): then one channel carries the light, and its
+ * value stands for all three. The light table on the device holds the uncorrected alphas. */
 #ifndef UMBRA_LIGHT_CHANNELS
 #define UMBRA_LIGHT_CHANNELS 3
 #endif
 
+#define UMBRA_ALPHA_MAX 0.99999994f /* 1 - 2^-24 */
+
+/* Extinction per voxel length of (interpolated) table opacity a: -ln(1 - a), at most 16.64. */
+inline float tf_extinction(float a) { return -log1p(-fmin(a, UMBRA_ALPHA_MAX)); }
+
 #if UMBRA_LIGHT_CHANNELS == 1
 typedef float light_t;
-inline light_t light_pass(float4 c, uint flags)
+/* Optical depth of len voxels of light transfer-function colour c, per light channel. */
+/* The fraction 1 - t of the extinction that light transfer-function colour c applies. */
+inline light_t light_absorbed(float4 c, uint flags)
 {
-    return 1.0f - c.w * ((flags & UMBRA_FLAG_COLORED) ? (1.0f - c.x) : 1.0f);
+    return (flags & UMBRA_FLAG_COLORED) ? 1.0f - c.x : 1.0f;
 }
 inline float3 light_rgb(light_t v) { return (float3)(v); }
 inline float light_max(light_t v) { return v; }
+inline float light_min(light_t v) { return v; }
 #else
 typedef float3 light_t;
-inline light_t light_pass(float4 c, uint flags)
+inline light_t light_absorbed(float4 c, uint flags)
 {
-    float3 t = (flags & UMBRA_FLAG_COLORED) ? c.xyz : (float3)(0.0f);
-    return 1.0f - c.w * (1.0f - t);
+    return (flags & UMBRA_FLAG_COLORED) ? 1.0f - c.xyz : (float3)(1.0f);
 }
 inline float3 light_rgb(light_t v) { return v; }
 inline float light_max(light_t v) { return fmax(v.x, fmax(v.y, v.z)); }
+inline float light_min(light_t v) { return fmin(v.x, fmin(v.y, v.z)); }
 #endif
+
+/* Optical depth of len voxels of light transfer-function colour c, per light channel. */
+inline light_t light_depth(float4 c, float len, uint flags)
+{
+    return (tf_extinction(c.w) * len) * light_absorbed(c, flags);
+}
+
+/* The fraction of light passing len voxels of light transfer-function colour c, per channel. */
+inline light_t light_pass(float4 c, float len, uint flags) { return exp(-light_depth(c, len, flags)); }
+
+/* The light step of a shadow structure in voxels (the length unit of the table's alpha). */
+inline float light_step_voxels(__global const UmbraFrame *F, __global const UmbraShadow *S)
+{
+    return S->step / F->step_ref;
+}
 
 /* The opacity a of one length unit over r units: 1 - (1 - a)^r, written -expm1(r log1p(-a)) so
  * that a near-transparent a (1e-6) keeps its relative precision, where 1 - a would round it away;

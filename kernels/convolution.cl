@@ -27,7 +27,7 @@
  *      n = 0 is ICS); every sample is a shadow receiver lit by the light interpolated between L_i
  *      and L_{i+1} with weight j/(n+1) (the paper's Figure 2) and an occluder: the light leaving
  *      the slab, A_i = L_i * product of the samples' light transmissions (the shading model's
- *      1 - a (1 - t), opacity corrected for the light's path dz/(n+1)/cos(light, view axis)).
+ *      (1 - a)^(D (1 - t)) over the light's path D = dz/(n+1)/cos(light, view axis)).
  *   3. with pre-integration each sample is a segment [z, z + dz/(n+1)] from the 2D tables: colour
  *      and opacity from the view table, the light attenuated by the light table's transmittance
  *      (tissue pre-integration; the light is taken at the segment's front, the paper's S1).
@@ -225,7 +225,7 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
     const int px = get_global_id(0), py = get_global_id(1);
     if (px >= rect.z || py >= rect.w)
         return;
-    (void)S;
+    const float h_light = light_step_voxels(F, S); /* the light sub-step along the view axis */
     const int idx = py * (int)F->width + px;
     const VolGeom g = vol_geom(F);
     const ConvCam cam = conv_cam(F, rect);
@@ -261,8 +261,9 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
     const float z_lo = P.z_in - 1e-4f * hsub;
     if (zi + dz > z_lo && zi < P.z_out) {
         const float r_light = 1.0f / fmax(-dot(to_light(F, p_slice).xyz, cam.fwd), geo.w);
-        /* Tables are corrected for the sub-step along the view axis (view table: for the ray
-         * caster's step); a perspective ray crosses the slab obliquely, the light at its angle. */
+        /* The view table is corrected for the ray caster's step, the pre-integration tables for
+         * the sub-step along the view axis, and the light's extinction is taken over h_light
+         * voxels there; a perspective ray crosses the slab obliquely, the light at its angle. */
         const float r_view = pi_size ? 1.0f / P.cosv : hsub / (P.cosv * F->step);
         const int skip = !pi_size && (flags & UMBRA_FLAG_SKIP_EMPTY);
         const float step_t = hsub / P.cosv;
@@ -298,8 +299,8 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
             } else {
                 float s = sample_volume(vol, g, p);
                 c = alpha_for_fraction(tf_lookup(view_tf, F->tf_size, s), r_view);
-                pass = light_pass(alpha_for_fraction(tf_lookup(light_tf, F->light_tf_size, s),
-                                                     r_light), flags);
+                pass = light_pass(tf_lookup(light_tf, F->light_tf_size, s), r_light * h_light,
+                                  flags);
             }
             T *= pass;
             if (c.w > 0.0f && !(alpha > F->termination)) {

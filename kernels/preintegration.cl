@@ -7,8 +7,9 @@
  *   PREINT_VIEW   (C, A): the segment's premultiplied colour and opacity, composited front to back
  *                 (emission-absorption, alpha per voxel as everywhere in umbra);
  *   PREINT_LIGHT  (T, 0): the per-channel transmittance of the shading model through the segment,
- *                 the product of 1 - a (1 - t_c) (t = 0 unless colored): the light attenuation with
- *                 pre-integrated opacity that the convolution paper proposes.
+ *                 the product of (1 - a)^(len (1 - t_c)) over its sub-steps (t = 0 unless
+ *                 colored; kernels/common.cl): the light attenuation with pre-integrated opacity
+ *                 that the convolution paper proposes.
  * The integral is evaluated numerically at the table's own resolution: the value interval between
  * two grid values is one "unit", and a segment spanning d = |j - i| units is d sub-steps of length
  * L / d, each sampled at its unit's midpoint. Since a sub-step depends only on (d, unit), the
@@ -28,10 +29,11 @@ inline float4 preint_substep(__global const float4 *tf, uint tf_size, float s, f
                              uint kind, uint colored)
 {
     float4 c = tf_lookup(tf, tf_size, s);
-    float a = alpha_for_length(c.w, len);
     if (kind == PREINT_VIEW)
-        return (float4)(c.xyz, a);
-    return (float4)(1.0f - a * (colored ? 1.0f - c.xyz : (float3)(1.0f)), 0.0f);
+        return (float4)(c.xyz, alpha_for_length(c.w, len));
+    /* light_pass of kernels/common.cl, with the transmission mode as an argument */
+    return (float4)(exp(-(tf_extinction(c.w) * len) * (colored ? 1.0f - c.xyz : (float3)(1.0f))),
+                    0.0f);
 }
 
 /* units[(d - 1) * (size - 1) + k]: the sub-step over unit k (values k/(size-1) .. (k+1)/(size-1))

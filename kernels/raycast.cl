@@ -35,6 +35,32 @@ inline float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, flo
     return c * (amb + light * F->kd * diff) + light * F->ks * spec;
 }
 
+/* The mean depth of the emission along a segment of opacity a, in units of its length, from its
+ * front: the emission density is sigma exp(-sigma s) at depth s, whose mean is
+ * 1/tau - (1 - a)/a, tau = -ln(1 - a): one half for a thin segment, 0 for an opaque one. */
+inline float emission_depth(float a)
+{
+    if (!(a < 1.0f))
+        return 0.0f;
+    if (a < 1e-3f)
+        return 0.5f + log1p(-a) / 12.0f; /* the series 1/2 - tau/12: 1/tau - (1-a)/a cancels */
+    return -1.0f / log1p(-a) - (1.0f - a) / a;
+}
+
+/* Where a plain sample at p (opacity a, step h along d) takes its light. A thin sample stands for
+ * the segment [t - h/2, t + h/2] around it; an opaque one is the first to see a surface that lies
+ * in (t - h, t], so it stands for that segment. Between the two the segment is blended by a, and
+ * the light is taken at the segment's mean emission depth: p + h (m - (1 + a)/2) along d, which
+ * is p for a thin sample and p - h for an opaque one. Taking it at p whatever the opacity made
+ * it depend on how deep behind a surface the sample happened to fall: across an opaque surface
+ * the light falls by exp(-sigma depth) within one view step, so a lit opaque face showed the view
+ * step's phase against the voxel grid as voxel-scale moire, and as noise with jitter. (A
+ * pre-integrated sample stands for [t, t + h]: its light at p + m h.) */
+inline float3 shadow_point(float3 p, float3 d, float h, float a)
+{
+    return p + (h * (emission_depth(a) - 0.5f * (1.0f + a))) * d;
+}
+
 /* The view ray through pixel (px, py): origin and unit direction. */
 inline void camera_ray(__global const UmbraFrame *F, int px, int py, float3 *o, float3 *d)
 {
@@ -94,7 +120,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         const int n = (int)ceil((t1 - t0) / h - jitter);
         /* Pre-integrated mode (preint_size != 0, kernels/preintegration.cl): sample k stands for
          * the segment [t, t + h], its colour and opacity from the table at (s(t), s(t + h)), its
-         * shading and shadow taken at the front. The back value is kept for the next segment. */
+         * shading taken at the front (its shadow: shadow_point). The back value is kept for the
+         * next segment. */
         int k_back = -1;
         float s_back = 0.0f;
         /* Empty-space skipping. The ray walks the sub-cells of the brick grid (CellWalk) and
@@ -140,7 +167,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                 c = tf_lookup(view_tf, tf_size, sample_volume(vol, g, p));
             }
             if (c.w > 0.0f) {
-                float3 s = SHADOW_FACTOR(sr, p);
+                float3 s = SHADOW_FACTOR(sr, preint_size ? p + (h * emission_depth(c.w)) * d
+                                                         : shadow_point(p, d, h, c.w));
                 float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p)
                                                             : (float3)(0.0f);
                 float3 lit = shade_sample(F, c.xyz, s, p, -d, grad);

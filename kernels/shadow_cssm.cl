@@ -3,16 +3,19 @@
  *
  * Generation, the paper's Table 1 (cssm_build): one photon per texel, on the light ray through
  * the texel centre, discretised into segments i. Per segment one random number r_i, shared by the
- * channels, and per channel the probability that the photon is not transmitted,
- * rho_i = alpha_i (1 - t_i) (1 - light_pass in the shading model: t is the light transfer
- * function's RGB in coloured mode, 0 in grey mode). Where rho_i > r_i the channel's depth is set
+ * channels, and per channel the probability that the photon is not transmitted. The paper has
+ * rho_i = alpha_i (1 - t_i) (t the light transfer function's RGB in coloured mode, 0 in grey
+ * mode); umbra takes rho_i = 1 - (1 - alpha_i)^(1 - t_i), 1 - light_pass of the shading model's
+ * extinction (kernels/common.cl), of which the paper's is the first-order form: the two agree in
+ * grey mode and for thin segments, and only umbra's is independent of the step in a homogeneous
+ * medium. Where rho_i > r_i the channel's depth is set
  * to min(c, z_i) (z grows along the ray, so that is the first such segment); the march stops once
  * every channel is set. Unset channels keep LS_DEPTH_NEVER. With UMBRA_LIGHT_CHANNELS == 1 (a grey
  * light) one channel is simulated and stored, not three.
  *
- * Segments are the reference's: whole steps of S->step plus one partial step, sampled at their
- * midpoints with the step-corrected light table (the partial one re-corrected), so the product of
- * the (1 - rho_i) along a whole ray is the reference's transmittance. z_i is the depth of segment
+ * Segments: whole steps of S->step plus one partial step, sampled at their midpoints, each with
+ * the optical depth of its length, so the product of the (1 - rho_i) along a whole ray is the
+ * midpoint-rule transmittance. z_i is the depth of segment
  * i's midpoint, its sample point: a sample at depth s is then shadowed by exactly the segments
  * whose sample lies in front of it, so P(lit) = prod over those of (1 - rho_i), within half a step
  * of the continuous exp(-sigma d) on either side, and no bias is needed (the paper has none).
@@ -60,7 +63,7 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
     const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
     light_t c = (light_t)(LS_DEPTH_NEVER);
     if (tb.y > tb.x) {
-        const float h = S->step;
+        const float h = S->step, h_vox = light_step_voxels(F, S);
         const uint n_tf = F->light_tf_size, flags = F->flags, seed = S->seed;
         const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         const float len = tb.y - tb.x;
@@ -78,10 +81,8 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
                 break;
             const float t_mid = tb.x + (float)k * h + 0.5f * seg;
             const float3 q = o + t_mid * d;
-            float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-            if (k == n_full)
-                col = alpha_for_fraction(col, seg / h);
-            const light_t rho = 1.0f - light_pass(col, flags);
+            const float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
+            const light_t rho = -expm1(-light_depth(col, h_vox * (seg / h), flags));
             const float r = umbra_random(seed, (uint)x, (uint)y, (uint)k);
             c = select(c, fmin(c, (light_t)(ls_depth(S, o, t_mid))), CSSM_HIT(rho, r));
             if (CSSM_ALL_SET(c))

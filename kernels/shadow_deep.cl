@@ -27,10 +27,10 @@
  * normalised depths k * h / (far - near): the same depth planes for every texel and sub-ray, so
  * the pre-filtered sub-rays can be combined segment by segment and no texel gets its own sampling
  * phase. A segment fully inside the box is integrated with the lookup table from the scalars at its
- * two ends, or (lookup_table = 0) with one sample at its midpoint -- the midpoint rule the exact
- * reference (kernels/shadow_reference.cl) uses, so a homogeneous medium gives exp(-sigma d) at
- * every node with or without the table. The partial segments where a ray enters or leaves the box
- * always use the midpoint rule with the opacity re-corrected for their length. */
+ * two ends, or (lookup_table = 0) with one sample at its midpoint, its optical depth that of the
+ * shading model's extinction over the segment (kernels/common.cl), so a homogeneous medium gives
+ * exp(-sigma d) at every node with or without the table. The partial segments where a ray enters
+ * or leaves the box always use the midpoint rule over their length. */
 
 #ifndef DEEP_BUILD_KERNELS
 #define DEEP_BUILD_KERNELS 0 /* the host's build program sets 1; the ray caster needs the lookup */
@@ -191,7 +191,7 @@ inline void deep_fit_finish(DeepFit *f, deep_node *e, int *n)
 /* ---- the pre-compressed segment table -------------------------------------------------------
  * Entry (i_f, i_b) covers a segment of one light step h whose scalar runs linearly from
  * s_f = i_f / (R-1) to s_b = i_b / (R-1). Its visibility is integrated at DEEP_LUT_SUBSTEPS
- * midpoint sub-steps with the (h-corrected) light table re-corrected to h / DEEP_LUT_SUBSTEPS,
+ * midpoint sub-steps of h / DEEP_LUT_SUBSTEPS each (the extinction of kernels/common.cl),
  * then compressed with the fit above within DEEP_LUT_TOL, or, where that needs more than
  * DEEP_LUT_INTERIOR interior nodes, within the smallest tolerance that needs no more. The end
  * value is exact (the fit pins the last point). Stored: DEEP_LUT_NODES nodes (x in (0, 1],
@@ -225,7 +225,7 @@ inline int deep_lut_fit(const light_t *v, float tol, int limit, deep_node *out)
 }
 
 __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *light_tf,
-                       __global deep_node *lut)
+                       __global deep_node *lut, float h_vox)
 {
     const int i_f = get_global_id(0), i_b = get_global_id(1);
     if (i_f >= DEEP_LUT_RES || i_b >= DEEP_LUT_RES)
@@ -239,9 +239,10 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
     for (int j = 0; j < DEEP_LUT_SUBSTEPS; ++j) {
         float s = mix(sf, sb, ((float)j + 0.5f) * frac);
         float4 c = tf_lookup(light_tf, n_tf, s);
-        /* alpha_for_fraction(c, frac), with the fast exp2 / log2: this loop is the table's cost */
-        c.w = 1.0f - native_exp2(native_log2(fmax(1.0f - c.w, 0.0f)) * frac);
-        v[j + 1] = v[j] * light_pass(c, flags);
+        /* light_pass(c, frac h_vox, flags) (the segment is one step of h_vox voxels), with the
+         * fast exp2 / log2: this loop is the table's cost */
+        const float l2 = native_log2(fmax(1.0f - c.w, 1.0f - UMBRA_ALPHA_MAX)) * (frac * h_vox);
+        v[j + 1] = v[j] * native_exp2(l2 * light_absorbed(c, flags));
     }
     deep_node out[DEEP_LUT_NODES];
     const light_t end = v[DEEP_LUT_SUBSTEPS];
@@ -448,9 +449,7 @@ inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, V
         } else {
             s->has_prev = 0;
             float3 mid = s->o + 0.5f * (a + b) * s->d;
-            float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, mid));
-            if (!full)
-                c = alpha_for_fraction(c, (b - a) / h);
+            const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, mid));
             float xa = (a - t0) / h, xb = (b - t0) / h;
             if (xa > 0.0f) {
                 p->x[p->n] = xa;
@@ -458,7 +457,7 @@ inline int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, V
                 p->n++;
             }
             p->x[p->n] = fmin(xb, 1.0f);
-            p->v[p->n] = s->v * light_pass(c, flags);
+            p->v[p->n] = s->v * light_pass(c, light_step_voxels(F, S) * ((b - a) / h), flags);
             p->n++;
         }
         any_points = 1;

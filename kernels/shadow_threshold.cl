@@ -8,8 +8,9 @@
  * shadowed (0) beyond it, lit (1) before; with S->taps > 1 it averages the tests at the CSSM tap
  * offsets (PCF), so that its softness compares fairly with CSSM's.
  *
- * The march is the reference's: whole steps of S->step plus one partial step, each sampled at its
- * midpoint with the step-corrected light table, empty bricks skipped on the same grid. Within the
+ * The march: whole steps of S->step plus one partial step, each sampled at its midpoint, its
+ * opacity that of the extinction of kernels/common.cl over the segment's length, empty cells
+ * skipped. Within the
  * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
  * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
  * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. */
@@ -39,7 +40,7 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
     const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
     float depth = LS_DEPTH_NEVER;
     if (tb.y > tb.x) {
-        const float h = S->step, thr = S->threshold;
+        const float h = S->step, thr = S->threshold, h_vox = light_step_voxels(F, S);
         const uint n_tf = F->light_tf_size;
         const int skip = (F->flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         const float len = tb.y - tb.x;
@@ -59,13 +60,13 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_start = tb.x + (float)k * h;
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
-            float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-            if (k == n_full)
-                c = alpha_for_fraction(c, seg / h);
-            const float a = c.w;
+            const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
+            /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
+             * alpha over seg / h steps of h_vox voxels) and its opacity. */
+            const float od = tf_extinction(c.w) * h_vox * (seg / h);
+            const float a = -expm1(-od);
             if (A + (1.0f - A) * a > thr) {
-                /* ln(1 - a) is -inf for a == 1: the crossing is then at the segment's start. */
-                const float frac = log((1.0f - thr) / (1.0f - A)) / log(1.0f - a);
+                const float frac = -log((1.0f - thr) / (1.0f - A)) / od;
                 depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
                 break;
             }

@@ -1,10 +1,11 @@
 /* tests/test_raycast.c: the foundation's ray caster and exact shadow reference, pinned down.
  *
  *  - the reference shadow factor in a homogeneous volume equals the analytic exp(-sigma d)
- *    (grey) or the shading model's per-step product (coloured), for many points, lights and
- *    reference steps, on isotropic and anisotropic grids;
+ *    (grey) or exp(-sigma d (1 - t_c)) (coloured), for many points, lights and reference steps,
+ *    on isotropic and anisotropic grids;
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
- *    pixel (<= 1e-4 per channel) and sample for sample;
+ *    pixel (<= 1e-4 per channel; with the exact reference's adaptive shadow rays <= 1e-3, and
+ *    at most 0.5% of values over 1e-4) and sample for sample;
  *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
  *    edge cases (odd brick sizes, rays running in cell faces);
  *  - an application's own cl_context / device / queue work and are left as they were found;
@@ -119,16 +120,12 @@ static void set_reference(umbra_renderer r, float step_voxels)
 enum { SLAB_POINTS = 96 };
 
 /* Expected transmittance of channel t (transmission colour) over a path of d_steps reference
- * steps, per the shading model: each whole step passes 1 - a_h (1 - t), the final partial step of
- * fraction f passes 1 - (1 - (1 - a_h)^f)(1 - t), with a_h = 1 - (1 - a)^h the step-corrected
- * opacity. For t = 0 this is (1 - a)^(d in voxels) = exp(-sigma d) exactly. */
+ * steps of h voxels, per the shading model's extinction sigma (1 - t): (1 - a)^(d (1 - t)) with d
+ * in voxels, whatever the step (the old model, 1 - a_h (1 - t) per step, was first order in the
+ * step: 0.43 at step 1 for 0.33 in the limit, issue 10). */
 static double model_transmittance(double a, double h_voxels, double d_steps, double t)
 {
-    double a_h = 1.0 - pow(1.0 - a, h_voxels);
-    double n_full = floor(d_steps);
-    double f = d_steps - n_full;
-    double a_f = 1.0 - pow(1.0 - a_h, f);
-    return pow(1.0 - a_h * (1.0 - t), n_full) * (1.0 - a_f * (1.0 - t));
+    return pow(1.0 - a, d_steps * h_voxels * (1.0 - t));
 }
 
 /* Queries SLAB_POINTS points (inside the box and a few below it) and compares each channel with
@@ -225,7 +222,7 @@ static void test_reference_slab_matches_exp(void **state)
         assert_int_equal(umbra_renderer_get_stats(r, &stats), UMBRA_SUCCESS);
         assert_int_equal(stats.light_channels, 1);
 
-        /* Coloured transmission: per channel, the product over steps of 1 - a_h (1 - t). */
+        /* Coloured transmission: per channel exp(-sigma d (1 - t)), to 1e-4 at every step. */
         umbra_render_desc o;
         umbra_render_desc_init(&o);
         o.transmission = UMBRA_TRANSMISSION_COLORED;
@@ -254,10 +251,9 @@ static void test_reference_slab_matches_exp(void **state)
  * voxels, with an axis-aligned and an oblique light. Expected: exp(d log(1 - a)) in double.
  * Bounds: near-opaque, 1e-3 relative, or 1.5e-6 absolute where the shadow ray stops (it returns
  * 0 once the transmittance drops below 1e-6, kernels/shadow_reference.cl); near-transparent, 1% of
- * the attenuation 1 - T plus 2e-7. The transmittance is a float product (~2000 factors 1 - a/4
- * here), each factor held to half an ulp (3e-8): for a = 1e-5 that is 1% of its opacity and the
- * test uses 0.4 of its bound; at a = 1e-6 the attenuation is 4% off (an absolute 3e-7), which is
- * why 1e-5 is the smallest opacity asserted (README, "Hard cases"). */
+ * the attenuation 1 - T plus 2e-7. (Written when the transmittance was a float product, whose
+ * factors 1 - a/4 each lost half an ulp; since issue 10 the reference sums optical depths, and
+ * tests/test_fidelity.c holds a = 1e-6 over 512 voxels to 3e-7 at steps down to 0.01.) */
 static void test_reference_extreme_opacity_long_path(void **state)
 {
     umbra_context ctx = *state;
@@ -435,9 +431,19 @@ static void test_raycast_matches_cpu_reference(void **state)
                       c->ortho ? "ortho" : "persp", c->point_light ? "point" : "dir  ",
                       c->colored ? "coloured" : "grey    ", umbra_shadow_technique_name(c->technique),
                       err, (unsigned long long)stats.samples, (unsigned long long)samples);
-        if (err > 1e-4)
-            fail_msg("case %zu: pixel (%zu, %zu) channel %zu: umbra %.7f, cpu %.7f", i,
-                     (at / 4) % RC_W, (at / 4) / RC_W, at % 4, gpu[at], cpu[at]);
+        /* 1e-4 per channel. With the exact reference, 1e-3 at a few values: its shadow rays
+         * refine a segment where the extinction along it varies by more than a threshold
+         * (kernels/shadow_reference.cl), and float rounding that differs between the two can
+         * put a segment on either side of it, which moves that ray's value by up to the
+         * refinement's own tolerance; at most 0.5% of the values may differ by more than 1e-4. */
+        size_t over = 0;
+        for (size_t k = 0; k < (size_t)RC_W * RC_H * 4; ++k)
+            over += fabs((double)gpu[k] - cpu[k]) > 1e-4;
+        const int refined = c->technique == UMBRA_SHADOW_REFERENCE;
+        if (err > (refined ? 1e-3 : 1e-4) || (double)over > 0.005 * RC_W * RC_H * 4)
+            fail_msg("case %zu: pixel (%zu, %zu) channel %zu: umbra %.7f, cpu %.7f (%zu values "
+                     "over 1e-4)", i, (at / 4) % RC_W, (at / 4) / RC_W, at % 4, gpu[at], cpu[at],
+                     over);
         assert_true(stats.samples > 0);
         assert_int_equal(stats.samples, samples);
         free(voxels);

@@ -7,14 +7,17 @@
  * render() rebuilds only what the change calls for (moving the camera re-uses a shadow map built
  * for the same light, volume and light transfer function).
  *
- * Shading model, shared by every technique. A sample of (step-corrected) opacity a and
- * transmission colour t passes the fraction 1 - a (1 - t_c) of light channel c (the CSSM paper's
- * rho = a (1 - t)). The shadow factor S_c at a point is the product of these fractions along the
- * path to the light. t is 0 in UMBRA_TRANSMISSION_GREY mode (classic grey shadows) or the RGB of
- * the light transfer function in UMBRA_TRANSMISSION_COLORED mode (coloured shadows: red material
- * lets red light through). A sample of colour c is then lit as
+ * Shading model, shared by every technique. Light is absorbed per channel with extinction
+ * sigma (1 - t_c): sigma = -ln(1 - a) per voxel length (the smallest spacing) of the light
+ * transfer function's alpha a (interpolated, at most 1 - 2^-24), t the transmission colour, so a
+ * length of D voxels at one value passes (1 - a)^(D (1 - t_c)) of channel c (the CSSM paper's
+ * rho = a (1 - t) is its one-sample form). The shadow factor S_c at a point is exp(-optical depth)
+ * along the path to the light. t is 0 in UMBRA_TRANSMISSION_GREY mode (classic grey shadows) or
+ * the RGB of the light transfer function in UMBRA_TRANSMISSION_COLORED mode (coloured shadows:
+ * red material lets red light through). A sample of colour c is then lit as
  *     c * (ambient + light * S * (shading ? kd |N.L| : 1)) + (shading ? light * S * ks |N.H|^n : 0)
- * and composited front to back (emission-absorption, Max 1995). The ground plane is lit as
+ * and composited front to back (emission-absorption, Max 1995), with S taken at the mean emission
+ * depth of the view segment the sample stands for (kernels/raycast.cl). The ground plane is lit as
  *     ground * (ambient + light * S * max(0, N.L)). */
 #ifndef UMBRA_RENDERER_H
 #define UMBRA_RENDERER_H

@@ -5,11 +5,14 @@
  * (umbra_transfer_function_set_range, or "range LO HI" in a file) the entries span data values
  * LO..HI instead, in the volume's own units (e.g. Hounsfield units), whatever the volume's value
  * range: the renderer resamples the table onto each volume's range, and data values outside
- * LO..HI take the end entries. Alpha is the opacity of one sample taken every voxel (the
- * reference step); renderers correct it for their own step with
- * a' = 1 - (1 - a)^(step / reference_step). RGB is the emitted colour for the view, and for a light
- * transfer function in UMBRA_TRANSMISSION_COLORED mode the transmission colour t of the shading
- * model (see renderer.h). */
+ * LO..HI take the end entries. Alpha is the opacity of one voxel length (the smallest spacing).
+ * The light pass interpolates first, then converts the alpha to the extinction -ln(1 - a) per
+ * voxel (a at most 1 - 2^-24), so a step of D voxels has opacity 1 - (1 - a)^D of the
+ * interpolated a: the order that converges to one continuous model as the step shrinks
+ * (correcting the entries first gives a step-dependent one). The view pass corrects the entries
+ * for its step, a' = 1 - (1 - a)^step, then interpolates. RGB is the emitted colour for the view,
+ * and for a light transfer function in UMBRA_TRANSMISSION_COLORED mode the transmission colour t
+ * of the shading model (see renderer.h). */
 #ifndef UMBRA_TRANSFER_FUNCTION_H
 #define UMBRA_TRANSFER_FUNCTION_H
 

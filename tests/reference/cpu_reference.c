@@ -29,9 +29,11 @@ typedef struct prep {
     const cpu_scene *s;
     v3 bmin, bmax, spacing, inv_spacing;
     float voxel;                  /* world length of one voxel step: the smallest spacing */
-    float *view_tf, *light_tf;    /* alpha corrected for the view step / the shadow step */
+    float *view_tf, *light_tf;    /* alpha corrected for the view step / as given (light) */
     int view_n, light_n;
     unsigned char *light_bricks;  /* per brick, visible to the light transfer function */
+    double *light_int;            /* per light table interval: the integral of the extinction
+                                     times 1 - t (r, g, b) and times 1 (grey), table units */
     uint64_t *view_cells;         /* per brick, its visible sub-cells (CELLS^3 bits, x fastest) */
     int nb[3], B, C;              /* bricks per axis, brick edge, sub-cell edge (voxels) */
     float step, shadow_step;
@@ -81,7 +83,9 @@ static float *corrected(const float *tf, int n, float step_voxels)
     for (int i = 0; i < n; ++i) {
         memcpy(t + 4 * i, tf + 4 * i, 3 * sizeof *t);
         double a = tf[4 * i + 3];
-        t[4 * i + 3] = a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a)) : 1.0f;
+        t[4 * i + 3] = step_voxels == 0.0f ? (float)a
+                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                 : 1.0f;
     }
     return t;
 }
@@ -314,9 +318,28 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->light_n = s->light_tf ? s->light_tf_count : s->tf_count;
     P->view_n = s->tf_count;
     P->view_tf = corrected(s->tf, s->tf_count, s->opts.step);
-    P->light_tf = corrected(ltf, P->light_n, s->reference_step);
+    P->light_tf = corrected(ltf, P->light_n, 0.0f);
     P->view_cells = cells(P, s->tf, s->tf_count);
     P->light_bricks = bricks(P, ltf, P->light_n);
+    P->light_int = malloc((size_t)4 * (P->light_n - 1) * sizeof *P->light_int);
+    if (P->light_int)
+        for (int i = 0; i + 1 < P->light_n; ++i) {
+            /* composite three-point Gauss over 16 pieces, in double */
+            static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+            static const double gw[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+            double *o = P->light_int + 4 * i;
+            o[0] = o[1] = o[2] = o[3] = 0.0;
+            for (int q = 0; q < 48; ++q) {
+                double w = (q / 3 + 0.5 + 0.5 * gx[q % 3]) / 16.0, c[4];
+                for (int k = 0; k < 4; ++k)
+                    c[k] = ltf[4 * i + k] + w * (ltf[4 * i + 4 + k] - ltf[4 * i + k]);
+                double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
+                double sg = -log1p(-a) * gw[q % 3] / 16.0;
+                for (int k = 0; k < 3; ++k)
+                    o[k] += sg * (1.0 - c[k]);
+                o[3] += sg;
+            }
+        }
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
     P->point = s->light.type == UMBRA_LIGHT_POINT;
     P->light_vec = P->point ? from(s->light.position) : norm(from(s->light.direction));
@@ -328,6 +351,7 @@ static void prep_free(prep *P)
     free(P->light_tf);
     free(P->view_cells);
     free(P->light_bricks);
+    free(P->light_int);
 }
 
 /* The interval [*t0, *t1] of o + t d inside the box; *t1 < *t0 when the ray misses. */
@@ -361,23 +385,6 @@ static int brick_of(const prep *P, v3 p, int b[3])
     return (b[2] * P->nb[1] + b[1]) * P->nb[0] + b[0];
 }
 
-/* Ray parameter where o + t d leaves the brick holding o + t_now d (border bricks unbounded). */
-static float brick_exit(const prep *P, v3 o, v3 d, float t_now)
-{
-    int b[3];
-    brick_of(P, add(o, mul(d, t_now)), b);
-    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
-    float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, sp[3] = {P->spacing.x, P->spacing.y, P->spacing.z};
-    float t = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        if (dd[a] > 0.0f && b[a] < P->nb[a] - 1)
-            t = fminf(t, (((float)((b[a] + 1) * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
-        if (dd[a] < 0.0f && b[a] > 0)
-            t = fminf(t, (((float)(b[a] * P->B) + 0.5f) * sp[a] + bmin[a] - oo[a]) / dd[a]);
-    }
-    return t;
-}
-
 static int next_after(float t0, float h, float off, float t_exit, int k)
 {
     float kk = ceilf((t_exit - t0) / h - off);
@@ -397,16 +404,143 @@ static v3 to_light(const prep *P, v3 p, float *dist)
     return mul(P->light_vec, -1.0f);
 }
 
-static void pass(const prep *P, const float c[4], float out[3])
+/* The shading model's light transport (renderer.h): extinction -ln(1 - a) per voxel of the
+ * interpolated alpha, a at most 1 - 2^-24, times 1 - t_c per channel (t = 0 in grey mode). */
+static void depth_rate(const prep *P, const float c[4], float out[3])
 {
+    float a = c[3] < 0.99999994f ? c[3] : 0.99999994f;
+    float sigma = -log1pf(-a);
     for (int ch = 0; ch < 3; ++ch)
-        out[ch] = 1.0f - c[3] * (1.0f - (P->colored ? c[ch] : 0.0f));
+        out[ch] = sigma * (P->colored ? 1.0f - c[ch] : 1.0f);
 }
 
-/* The exact reference's shadow ray. It skips whole bricks the light transfer function leaves
- * empty, where the kernel walks their sub-cells (kernels/shadow_reference.cl): both skip only
- * samples of opacity 0 on the same sample grid, so the values agree and the simpler test stays
- * an independent check of the kernel's walk. */
+/* Three-point Gauss over [a, b] (table units, within one interval) of the extinction rate per
+ * channel, added to out; lo, hi take the outer nodes' range. A transparent interval adds 0 and
+ * sets lo to 0, as the kernel does. */
+static void piece(const prep *P, float a, float b, double out[3], float *lo, float *hi)
+{
+    const int n = P->light_n;
+    const float last = (float)(n - 1);
+    int i = (int)a < n - 2 ? (int)a : n - 2;
+    if (P->light_tf[4 * i + 3] == 0.0f && P->light_tf[4 * i + 7] == 0.0f) {
+        *lo = 0.0f;
+        return;
+    }
+    float m = 0.5f * (a + b), hw = 0.38729833f * (b - a), c[4], r[3];
+    for (int q = -1; q <= 1; ++q) {
+        lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
+        depth_rate(P, c, r);
+        for (int ch = 0; ch < 3; ++ch) {
+            out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
+            if (q) {
+                *lo = fminf(*lo, r[ch]);
+                *hi = fmaxf(*hi, r[ch]);
+            }
+        }
+    }
+}
+
+/* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
+ * the mean extinction over [v0, v1]: the partial table intervals at the ends by three-point
+ * Gauss, the whole ones between from their integrals (light_int), as kernels/shadow_reference.cl;
+ * *spread: the range of the extinction over the Gauss nodes and the whole intervals' mean,
+ * times len. */
+static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
+{
+    const int n = P->light_n;
+    const float last = (float)(n - 1);
+    float x0 = clampf(v0 < v1 ? v0 : v1, 0.0f, 1.0f) * last;
+    float x1 = clampf(v0 < v1 ? v1 : v0, 0.0f, 1.0f) * last;
+    float span = x1 - x0, c[4], r[3];
+    float lo = INFINITY, hi = 0.0f;
+    double sum[3] = {0, 0, 0};
+    *spread = 0.0f;
+    if (!(span > 0.0f)) {
+        lookup(P->light_tf, n, x0 / last, c);
+        depth_rate(P, c, r);
+        for (int ch = 0; ch < 3; ++ch)
+            out[ch] = r[ch] * len;
+        return;
+    }
+    int i0 = (int)x0 < n - 2 ? (int)x0 : n - 2, i1 = (int)x1 < n - 2 ? (int)x1 : n - 2;
+    if (i0 == i1) {
+        piece(P, x0, x1, sum, &lo, &hi);
+    } else {
+        piece(P, x0, (float)(i0 + 1), sum, &lo, &hi);
+        piece(P, (float)i1, x1, sum, &lo, &hi);
+        if (i1 > i0 + 1) {
+            double whole[4] = {0, 0, 0, 0};
+            for (int i = i0 + 1; i < i1; ++i)
+                for (int k = 0; k < 4; ++k)
+                    whole[k] += P->light_int[4 * i + k];
+            for (int ch = 0; ch < 3; ++ch) {
+                double w = P->colored ? whole[ch] : whole[3];
+                sum[ch] += w;
+                float mean = (float)(w / (i1 - i0 - 1));
+                lo = fminf(lo, mean);
+                hi = fmaxf(hi, mean);
+            }
+        }
+    }
+    for (int ch = 0; ch < 3; ++ch)
+        out[ch] = (float)(sum[ch] * (len / span));
+    *spread = (hi - lo) * len;
+}
+
+/* Where the ray x(t) = xo + t xd (voxel coordinates) crosses a plane of voxel centres inside the
+ * grid strictly within (ta, tb) (away from the ends by 1e-3 of the piece), the crossing nearest
+ * the middle over the three axes, or -1. */
+static float kink(const prep *P, const float xo[3], const float xd[3], float ta, float tb)
+{
+    float tm = 0.5f * (ta + tb), best = -1.0f;
+    for (int a = 0; a < 3; ++a) {
+        if (xd[a] == 0.0f)
+            continue;
+        float x0 = xo[a] + ta * xd[a], x1 = xo[a] + tb * xd[a];
+        float lo = fmaxf(fminf(x0, x1), 0.0f), hi = fminf(fmaxf(x0, x1), (float)(P->s->dims[a] - 1));
+        float c = rintf(xo[a] + tm * xd[a]);
+        c = c < ceilf(lo) ? ceilf(lo) : (c > floorf(hi) ? floorf(hi) : c);
+        if (!(c >= lo && c <= hi))
+            continue;
+        float t = (c - xo[a]) / xd[a], margin = 1e-3f * (tb - ta);
+        if (t > ta + margin && t < tb - margin && (best < 0.0f || fabsf(t - tm) < fabsf(best - tm)))
+            best = t;
+    }
+    return best;
+}
+
+/* segment, split at a new sample (recursively, at most 3 deep) as kernels/shadow_reference.cl:
+ * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-3 of
+ * optical depth, else at its middle if by more than 4e-3. */
+static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
+                            float ta, float tb, float va, float vb, float per_t, int level,
+                            double D[3])
+{
+    float f[3], spread;
+    segment(P, va, vb, (tb - ta) * per_t, f, &spread);
+    float tm = -1.0f;
+    if (level < 3 && spread > 1e-3f) {
+        tm = kink(P, xo, xd, ta, tb);
+        if (tm < 0.0f && spread > 4e-3f)
+            tm = 0.5f * (ta + tb);
+    }
+    if (tm >= 0.0f) {
+        float vm = sample(P, add(p, mul(d, tm)));
+        segment_refined(P, p, d, xo, xd, ta, tm, va, vm, per_t, level + 1, D);
+        segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, per_t, level + 1, D);
+        return;
+    }
+    for (int ch = 0; ch < 3; ++ch)
+        D[ch] += f[ch];
+}
+
+/* The exact reference's shadow ray: samples at the ends of steps of h from the point (the last
+ * step partial), each segment's optical depth integrated through the transfer function, depths
+ * summed in double and exponentiated once. It skips segments whose two ends lie in bricks the
+ * light transfer function leaves empty, where the kernel walks their sub-cells
+ * (kernels/shadow_reference.cl): both skip only segments of depth 0 (but for a visible cell
+ * crossed between two samples, which neither samples), so the simpler test stays an independent
+ * check of the kernel's walk. */
 static v3 shadow(const prep *P, v3 p)
 {
     float dist;
@@ -416,41 +550,31 @@ static v3 shadow(const prep *P, v3 p)
     float t_start = fmaxf(ta, 0.0f), t_end = fminf(tb, dist);
     if (!(t_end > t_start))
         return mk(1, 1, 1);
-    const float h = P->shadow_step;
+    const float h = P->shadow_step, h_vox = P->s->reference_step;
     float len = t_end - t_start;
     int n_full = (int)floorf(len / h);
     float last = len - (float)n_full * h;
-    float T[3] = {1, 1, 1}, c[4], f[3];
+    double D[3] = {0, 0, 0};
+    const float xo[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+                         (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+                         (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    const float xd[3] = {d.x * P->inv_spacing.x, d.y * P->inv_spacing.y, d.z * P->inv_spacing.z};
     int skip = P->s->opts.empty_space_skipping, b[3];
-    float t_visible = -INFINITY;
-    for (int k = 0; k < n_full;) {
-        float t = t_start + ((float)k + 0.5f) * h;
-        v3 q = add(p, mul(d, t));
-        if (skip && t >= t_visible) {
-            float t_exit = brick_exit(P, p, d, t);
-            if (!P->light_bricks[brick_of(P, q, b)]) {
-                k = next_after(t_start, h, 0.5f, t_exit, k);
-                continue;
-            }
-            t_visible = t_exit; /* the brick table is read once per brick crossed */
-        }
-        lookup(P->light_tf, P->light_n, sample(P, q), c);
-        pass(P, c, f);
-        for (int ch = 0; ch < 3; ++ch)
-            T[ch] *= f[ch];
-        if (fmaxf(T[0], fmaxf(T[1], T[2])) < 1e-6f)
+    for (int k = 0; k <= n_full; ++k) {
+        float ta_k = t_start + (float)k * h;
+        float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
+        float seg = k < n_full ? h_vox : h_vox * (last / h);
+        if (k == n_full && !(last > 0.0f))
+            break;
+        v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
+        if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
+            continue;
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb),
+                        seg / (tb_k - ta_k), 0, D);
+        if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
-        ++k;
     }
-    if (last > 0.0f) {
-        v3 q = add(p, mul(d, t_start + (float)n_full * h + 0.5f * last));
-        lookup(P->light_tf, P->light_n, sample(P, q), c);
-        c[3] = c[3] < 1.0f ? -expm1f(last / h * log1pf(-c[3])) : 1.0f;
-        pass(P, c, f);
-        for (int ch = 0; ch < 3; ++ch)
-            T[ch] *= f[ch];
-    }
-    return mk(T[0], T[1], T[2]);
+    return mk((float)exp(-D[0]), (float)exp(-D[1]), (float)exp(-D[2]));
 }
 
 static v3 shadow_factor(const prep *P, v3 p)
@@ -561,7 +685,16 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 ++taken;
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
                 if (c[3] > 0.0f) {
-                    v3 sf = shadow_factor(P, p);
+                    /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
+                     * a segment of opacity a (kernels/raycast.cl, shadow_point). */
+                    float a = c[3], m;
+                    if (!(a < 1.0f))
+                        m = 0.0f;
+                    else if (a < 1e-3f)
+                        m = 0.5f + log1pf(-a) / 12.0f;
+                    else
+                        m = -1.0f / log1pf(-a) - (1.0f - a) / a;
+                    v3 sf = shadow_factor(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
                     v3 light = vmul(from(s->light.color), sf);
                     v3 amb = from(o->ambient);
                     v3 lit;
@@ -617,7 +750,7 @@ cpu_prepared *cpu_prepare(const cpu_scene *s)
     if (!p)
         return NULL;
     prep_init(&p->P, s);
-    if (!p->P.view_tf || !p->P.light_tf || !p->P.light_bricks ||
+    if (!p->P.view_tf || !p->P.light_tf || !p->P.light_bricks || !p->P.light_int ||
         !p->P.view_cells) {
         cpu_prepared_free(p);
         return NULL;
