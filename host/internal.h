@@ -130,6 +130,9 @@ struct umbra_transfer_function_t {
     uint64_t id;             /* unique per table */
 };
 
+/* The most control points a transfer function may be built from (the most table entries too). */
+#define UMBRA__TF_MAX_POINTS 65536u
+
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);
 

@@ -10,7 +10,8 @@
  * what the file can hold before allocating anything, and decodes raw, gzip (zlib), ZRL, ascii and
  * hex itself. Limits, all refused with a message naming the value and the limit:
  *   - the header text is at most NRRD_HEADER_MAX bytes;
- *   - raw and hex data must be present in full; ascii needs two characters per value;
+ *   - raw data must fill the rest of its file exactly (after any line and byte skips); hex needs
+ *     two characters a byte, ascii two a value;
  *   - gzip data can expand at most GZIP_MAX_RATIO : 1 (deflate's own bound, 1032:1), ZRL at most
  *     ZRL_MAX_RATIO : 1 (four bytes encode at most 65535 zeros);
  *   - bzip2 and data split over several files are not read.
@@ -631,7 +632,12 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         int fits;
         const char *limit;
         switch (enc) {
-        case ENC_RAW: fits = bytes <= remaining; limit = "raw data is stored in full"; break;
+        case ENC_RAW:
+            /* Exactly: a data file that is longer (say /etc/passwd named as the data of a small
+             * volume) is not this volume's data. */
+            fits = bytes == remaining;
+            limit = "raw data must fill the file exactly";
+            break;
         case ENC_HEX: fits = bytes <= remaining / 2; limit = "hex needs 2 characters a byte"; break;
         case ENC_ASCII:
             fits = count <= remaining / 2 + 1;
@@ -650,7 +656,7 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         if (!fits) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                              "%s: \"%s\": sizes %u x %u x %u of %zu-byte values (%zu bytes) "
-                             "cannot come from the %zu bytes of %s data in \"%s\" (%s)",
+                             "do not match the %zu bytes of %s data in \"%s\" (%s)",
                              func, path, dims[0], dims[1], dims[2], type_size, bytes, remaining,
                              enc_names[enc], data_name, limit);
             goto fail;

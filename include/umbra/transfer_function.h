@@ -29,16 +29,18 @@ typedef struct umbra_tf_point {
     float rgba[4];
 } umbra_tf_point;
 
-/* Builds a table of resolution entries by linear interpolation between points (sorted by value,
- * at least one). Values outside the first and last point take those points' colours. */
+/* Builds a table of resolution entries (2..65536) by linear interpolation between points (sorted
+ * by value, 1..65536 of them; more is UMBRA_ERROR_INVALID_ARGUMENT). Values outside the first and
+ * last point take those points' colours. Copies points. */
 umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
                                                         const umbra_tf_point *points,
                                                         uint32_t count, uint32_t resolution,
                                                         umbra_transfer_function *out);
 
 /* Reads the text format documented in the README (and host/tf_file.c): '#' comments, an optional
- * line "resolution N" (default 256) before the first point, then one control point
- * "value r g b a" per line, values ascending (equal values make a step). */
+ * line "resolution N" (2..65536, default 256) before the first point, then one control point
+ * "value r g b a" per line (at most 65536), values ascending (equal values make a step). The file
+ * must be a regular file; errors are UMBRA_ERROR_IO or UMBRA_ERROR_FORMAT naming path:line. */
 umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                           umbra_transfer_function *out);
 
