@@ -136,13 +136,19 @@ static int parse_float(const char *s, float *out)
     return 1;
 }
 
+/* Decimal digits only, at most UINT32_MAX: no sign, blank or trailing text. */
 static int parse_uint(const char *s, uint32_t *out)
 {
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (end == s || *end != '\0' || errno != 0 || s[0] == '-' || v > 0xffffffffUL)
+    uint64_t v = 0;
+    if (!*s)
         return 0;
+    for (; *s; ++s) {
+        if (*s < '0' || *s > '9')
+            return 0;
+        v = 10 * v + (uint64_t)(*s - '0');
+        if (v > 0xffffffffu)
+            return 0;
+    }
     *out = (uint32_t)v;
     return 1;
 }
