@@ -107,7 +107,15 @@ static int is_blank(char c)
 static umbra_status header_split(umbra_context ctx, const char *func, const char *path,
                                  const char *buf, size_t got, size_t file_size, nrrd_header *h)
 {
-    size_t pos = 0, out = 0;
+    /* The fields every NRRD header must have. Checked here, not left to Teem: a header without
+     * them reaches Teem's final consistency check, whose error path leaks. */
+    static const int required[4] = {nrrdField_type, nrrdField_dimension, nrrdField_sizes,
+                                    nrrdField_encoding};
+    int seen[4] = {0, 0, 0, 0};
+    size_t pos = 0, out = 0, k;
+    int field;
+    /* Anything else is left to Teem, which names what it expected. */
+    const int is_nrrd = got >= 4 && memcmp(buf, "NRRD", 4) == 0;
     h->text = malloc(got + 2);
     if (!h->text) {
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory for the header of "
@@ -144,12 +152,40 @@ static umbra_status header_split(umbra_context ctx, const char *func, const char
         }
         /* Teem's own rule (_nrrdReadNrrdParseField): a field is the text before the first ": ",
          * looked up in the nrrdField table; '#' starts a comment. */
-        colon = line[0] == '#' ? NULL : strstr(line, ": ");
-        if (colon && colon < line + len && (size_t)(colon - line) < 64) {
+        colon = NULL;
+        if (line[0] != '#') {
+            /* Within this line only: the buffer is not one string, and a search past the line
+             * would make a header of many short lines quadratic. */
+            for (k = 0; k + 1 < len && k < 64; ++k) {
+                if (line[k] == ':' && line[k + 1] == ' ') {
+                    colon = line + k;
+                    break;
+                }
+            }
+        }
+        if (is_nrrd && line[0] != '#' && pos > 0 && !colon) {
+            /* Neither a field nor a key/value (":="): Teem refuses such a line too, but leaks on
+             * that path (88 bytes a load), so it is refused here first. */
+            int keyvalue = 0;
+            for (k = 0; k + 1 < len; ++k) {
+                keyvalue |= line[k] == ':' && line[k + 1] == '=';
+            }
+            if (!keyvalue) {
+                return umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                   "%s: \"%s\": header line \"%.*s\" is neither a field "
+                                   "(\"name: value\") nor a key/value (\"key:=value\")",
+                                   func, path, (int)(len > QUOTE_MAX ? QUOTE_MAX : len), line);
+            }
+        }
+        if (colon) {
             char key[64];
             memcpy(key, line, (size_t)(colon - line));
             key[colon - line] = '\0';
-            if (airEnumVal(nrrdField, key) == nrrdField_data_file) {
+            field = airEnumVal(nrrdField, key);
+            for (k = 0; k < 4; ++k) {
+                seen[k] |= field == required[k];
+            }
+            if (field == nrrdField_data_file) {
                 const char *v = colon + 2, *end = line + len;
                 while (v < end && is_blank(*v)) {
                     ++v;
@@ -187,6 +223,13 @@ static umbra_status header_split(umbra_context ctx, const char *func, const char
         pos = next;
     }
     h->text[out] = '\0';
+    for (k = 0; k < 4; ++k) {
+        if (!seen[k] && is_nrrd) {
+            return umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                               "%s: \"%s\": the header has no \"%s\" field (required)", func,
+                               path, airEnumStr(nrrdField, required[k]));
+        }
+    }
     return UMBRA_SUCCESS;
 }
 
