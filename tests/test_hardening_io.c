@@ -1,4 +1,4 @@
-/* tests/test_hardening_io.c: hostile files (issue 11, rows 2, 8, 9, 12, 13).
+/* tests/test_hardening_io.c: hostile files (issue 11, rows 2, 8, 9, 11, 12, 13).
  *
  * Each test names the case it pins down. FIFOs given as any input (the volume, a .dat's or a
  * NRRD's data file, a transfer function, an image, also through a symbolic link) must be refused at once, not waited on: the
@@ -547,6 +547,32 @@ static void test_tf_more_points_than_the_limit_is_refused(void **state)
     free(pts);
 }
 
+/* Row 11 in the TF file: "resolution" is a whole number in [2, 65536] written as plain digits;
+ * strtoll took "+256" and " 256"-style signs before. */
+static void test_tf_resolution_is_parsed_strictly(void **state)
+{
+    umbra_context ctx = *state;
+    char path[PATH_LEN];
+    static const char *const bad[] = {"+256", "4294967552", "18446744073709551872", "-256",
+                                      "256x", "0x100", "65537", "1"};
+    umbra_transfer_function tf = NULL;
+    size_t i;
+    tmp_path(path, "resolution.tf");
+    for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char text[128];
+        snprintf(text, sizeof text, "resolution %s\n0 0 0 0 0\n1 1 1 1 1\n", bad[i]);
+        write_text(path, text);
+        assert_refused(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
+                       bad[i], "integer N in 2..65536");
+        assert_null(tf);
+    }
+    write_text(path, "resolution 65536\n0 0 0 0 0\n1 1 1 1 1\n");
+    assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
+    assert_int_equal(umbra_transfer_function_size(tf), 65536);
+    umbra_transfer_function_release(tf);
+    remove(path);
+}
+
 /* The merge-walk build against the plain definition (for each entry, the first point at or above
  * it), on point sets with steps (equal values), clusters and points outside the entries. */
 static void test_tf_table_build_matches_the_rescanning_build(void **state)
@@ -614,6 +640,7 @@ int main(void)
         cmocka_unit_test(test_nrrd_skips_and_zrl_decode),
         cmocka_unit_test(test_tf_more_points_than_the_limit_is_refused),
         cmocka_unit_test(test_tf_table_build_matches_the_rescanning_build),
+        cmocka_unit_test(test_tf_resolution_is_parsed_strictly),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
