@@ -29,9 +29,9 @@ expect() {
         sed 's/^/    /' "$tmp/err"
         echo "    (looked for: $needle)"
         failures=$((failures + 1))
-    else
-        echo "ok:   exit $got: umbra-render $*"
+        return 1
     fi
+    echo "ok:   exit $got: umbra-render $*"
 }
 
 # Row 10: --device P:D is the documented index form, not a name.
@@ -48,6 +48,14 @@ expect 1 "UMBRA_ERROR_UNSUPPORTED" -- "${small[@]}" --technique convolution --li
     --out "$tmp/a.png"
 expect 1 "UMBRA_ERROR_INVALID_ARGUMENT" -- "${small[@]}" --technique deep --map-size 9 \
     --out "$tmp/a.png"
+# Row 10: out of memory is a failure (2) wherever it happens, also while loading the volume. A
+# sparse 4 GiB file (no disk used) under a 3 GB address-space limit makes the voxel buffer fail.
+if truncate -s 4G "$tmp/big.raw" 2>/dev/null; then
+    (ulimit -v 3000000 && expect 2 "UMBRA_ERROR_OUT_OF_MEMORY" -- --raw "$tmp/big.raw" \
+        --raw-dims 2048x2048x1024 --raw-type uint8 --size 16x16 --out "$tmp/a.png") ||
+        failures=$((failures + 1))
+    rm -f "$tmp/big.raw"
+fi
 # Row 11: whole numbers are parsed strictly: no wrap-around, no sign, no trailing text.
 expect 1 "--raw-dims '4294967312x16x16' is not XxYxZ" -- --raw "$tmp/a.raw" \
     --raw-dims 4294967312x16x16 --raw-type uint8
