@@ -649,7 +649,16 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
             goto fail;
         }
     }
-    pos = (size_t)ftello(df);
+    {
+        off_t at = ftello(df);
+        if (at < 0 || (uint64_t)at > data_size) {
+            st = umbra__fail(ctx, UMBRA_ERROR_IO,
+                             "%s: \"%s\" changed while being read (now past its %zu bytes)", func,
+                             data_name, data_size);
+            goto fail;
+        }
+        pos = (size_t)at;
+    }
     remaining = data_size - pos;
     if (enc != ENC_GZIP && byte_skip >= 0) {
         if ((uint64_t)byte_skip > remaining) {
