@@ -48,13 +48,17 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .dat (Voreen). */
 umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
- * short and float; 3-D, or 4-D with a size-1 first axis. Spacing comes from the header's spacings
- * or space directions (1 where absent). */
+/* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
+ * absolute): types uchar, ushort, short and float; 3-D, or 4-D with a size-1 first axis; encodings
+ * raw, gzip, zrl, ascii and hex. Spacing comes from the header's spacings or space directions (1
+ * where absent). Teem parses the header, umbra reads the data. Header and data must be regular
+ * files (a FIFO or device is UMBRA_ERROR_IO, never waited on); the declared sizes are checked
+ * against the data before anything is allocated: raw data must fill the rest of its file exactly,
+ * gzip can expand at most 1032:1 and zrl 16384:1 (else UMBRA_ERROR_FORMAT naming both sizes). */
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads a Voreen .dat header and its raw file, which is looked up relative to the .dat's
- * directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
+/* Loads a Voreen .dat header and its raw file (both regular files), which is looked up relative
+ * to the .dat's directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
  * are required; ObjectModel, if present, must be I. */
 umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
 
@@ -69,7 +73,7 @@ typedef struct umbra_raw_desc {
 
 void umbra_raw_desc_init(umbra_raw_desc *desc);
 
-/* Loads a headerless raw file. The file must hold exactly header_bytes + dims product * type size
+/* Loads a headerless raw file (a regular file, else UMBRA_ERROR_IO). The file must hold exactly header_bytes + dims product * type size
  * bytes; any other size is UMBRA_ERROR_FORMAT naming both numbers. */
 umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
                                    umbra_volume *out);
