@@ -1498,8 +1498,10 @@ static void write_papers(bench_run *B)
     int n = 0;
     double ours[3][3];
     if (cssm_tables_mean(B, -1, 0, ours, &n)) {
-        char whose[128];
         char names[256] = "";
+        /* Room for the longest names plus the prefix: a possible truncation is a -Werror at -O0
+         * (the Debug build), where GCC cannot see the names are short. */
+        char whose[sizeof names + 32];
         for (int si = 0, k = 0; si < B->scene_count; ++si) {
             double dummy[3][3];
             int one = 0;

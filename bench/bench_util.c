@@ -60,12 +60,16 @@ void bench_csv_row(FILE *f, const char *name, bench_timing t, uint64_t samples)
 
 /* ---- command line ---------------------------------------------------------------------------------- */
 
+/* The bench's one whole-number check: an optional '-' then decimal digits only (strtol alone
+ * takes blanks, '+' and wraps nothing but says little), the value in [lo, hi]. */
 int bench_parse_int(const char *s, long lo, long hi, long *out)
 {
     char *end;
+    if (!s || (!(s[0] >= '0' && s[0] <= '9') && !(s[0] == '-' && s[1] >= '0' && s[1] <= '9')))
+        return -1;
     errno = 0;
-    long v = s ? strtol(s, &end, 10) : 0;
-    if (!s || !*s || *end || errno || v < lo || v > hi)
+    long v = strtol(s, &end, 10);
+    if (*end || errno || v < lo || v > hi)
         return -1;
     *out = v;
     return 0;
@@ -82,15 +86,20 @@ int bench_parse_float(const char *s, float lo, float hi, float *out)
     return 0;
 }
 
+/* "WxH", each side a whole number in [1, 16384] (sscanf's %u took "-1" and wrapped 2^32 + 64). */
 int bench_parse_size(const char *s, uint32_t *w, uint32_t *h)
 {
-    unsigned a, b;
-    char tail;
-    if (!s || sscanf(s, "%ux%u%c", &a, &b, &tail) != 2 || a < 1 || b < 1 || a > 16384 ||
-        b > 16384)
+    const char *x = s ? strchr(s, 'x') : NULL;
+    char side[16];
+    long a, b;
+    if (!x || (size_t)(x - s) >= sizeof side)
         return -1;
-    *w = a;
-    *h = b;
+    memcpy(side, s, (size_t)(x - s));
+    side[x - s] = '\0';
+    if (bench_parse_int(side, 1, 16384, &a) != 0 || bench_parse_int(x + 1, 1, 16384, &b) != 0)
+        return -1;
+    *w = (uint32_t)a;
+    *h = (uint32_t)b;
     return 0;
 }
 
@@ -104,7 +113,21 @@ umbra_context bench_context(const char *device)
 {
     umbra_context_desc d;
     umbra_context_desc_init(&d);
-    d.device_name = device;
+    /* "P:D" (platform and device indices), as --help documents; anything else is a name. */
+    const char *colon = device ? strchr(device, ':') : NULL;
+    char platform[16];
+    long p, q;
+    if (colon && (size_t)(colon - device) < sizeof platform) {
+        memcpy(platform, device, (size_t)(colon - device));
+        platform[colon - device] = '\0';
+    }
+    if (colon && (size_t)(colon - device) < sizeof platform &&
+        bench_parse_int(platform, 0, 1023, &p) == 0 && bench_parse_int(colon + 1, 0, 1023, &q) == 0) {
+        d.platform_index = (int)p;
+        d.device_index = (int)q;
+    } else {
+        d.device_name = device;
+    }
     d.error_callback = print_error; /* creation failures have no context to keep the message */
     umbra_context ctx = NULL;
     if (umbra_context_create(&d, &ctx) != UMBRA_SUCCESS)

@@ -7,11 +7,14 @@
 #include "scene_file.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define MAX_TOKENS 8
 
@@ -34,9 +37,27 @@ void scene_data_dir(const char *source_dir, char *buf, size_t size)
         snprintf(buf, size, "%s/../shared/data/volumes", source_dir ? source_dir : ".");
 }
 
+/* Opens a regular file for reading without blocking on a FIFO or device (a plain fopen of a FIFO
+ * waits for a writer forever); NULL for anything else. */
+static FILE *open_regular(const char *path)
+{
+    struct stat sb;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0)
+        return NULL;
+    int flags = fcntl(fd, F_GETFL);
+    FILE *f = NULL;
+    if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && flags >= 0 &&
+        fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == 0)
+        f = fdopen(fd, "rb");
+    if (!f)
+        close(fd);
+    return f;
+}
+
 static int file_exists(const char *path)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = open_regular(path);
     if (f)
         fclose(f);
     return f != NULL;
@@ -50,7 +71,7 @@ int scene_volume_present(const scene_spec *spec)
 /* Reads a whole file into a NUL-terminated malloc'ed buffer; NULL if it cannot. */
 static char *read_all(const char *path, size_t *n_out)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = open_regular(path);
     char *buf = NULL;
     size_t n = 0, cap = 0;
     if (!f)
@@ -115,13 +136,19 @@ static int parse_float(const char *s, float *out)
     return 1;
 }
 
+/* Decimal digits only, at most UINT32_MAX: no sign, blank or trailing text. */
 static int parse_uint(const char *s, uint32_t *out)
 {
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (end == s || *end != '\0' || errno != 0 || s[0] == '-' || v > 0xffffffffUL)
+    uint64_t v = 0;
+    if (!*s)
         return 0;
+    for (; *s; ++s) {
+        if (*s < '0' || *s > '9')
+            return 0;
+        v = 10 * v + (uint64_t)(*s - '0');
+        if (v > 0xffffffffu)
+            return 0;
+    }
     *out = (uint32_t)v;
     return 1;
 }

@@ -1,14 +1,20 @@
 /* umbra-render: the command-line front end. Renders a built-in scene or a volume file with a
  * chosen shadow technique into a PNG or EXR and prints each stage's time to stderr.
- * Run with --help for the options. Exit status: 0 on success, 1 on bad input, 2 on a failure,
- * 130 when interrupted (Ctrl-C stops the render between two pieces of device work). */
+ * Run with --help for the options. Exit status (as the README states): 0 on success; 1 on bad
+ * input: an option, a number, a file that is missing or malformed, an output path that cannot be
+ * written (checked before rendering), a request the technique cannot do; 2 on a failure of the
+ * device or of memory (no device, an OpenCL error, out of memory), or when writing the image fails
+ * after the render; 130 when interrupted (Ctrl-C stops the render between two pieces of device
+ * work). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -75,26 +81,110 @@ static int parse_floats(const char *s, float *out, int n)
     return *s == 0;
 }
 
-static int parse_uint(const char *s, uint32_t *out)
+/* The one integer parser of the command line: the n characters at s must be decimal digits only
+ * (no sign, blank or trailing text; sscanf's %u took "-1" as 4294967295 and 4294967312 as 16) and
+ * the value must lie in [lo, hi]. */
+static int parse_u32_n(const char *s, size_t n, uint32_t lo, uint32_t hi, uint32_t *out)
 {
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (end == s || *end || errno || v > 0xffffffffUL || s[0] == '-')
+    uint64_t v = 0;
+    if (n == 0 || n > 10)
+        return 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (s[i] < '0' || s[i] > '9')
+            return 0;
+        v = 10 * v + (uint64_t)(s[i] - '0');
+    }
+    if (v < lo || v > hi)
         return 0;
     *out = (uint32_t)v;
     return 1;
 }
 
-static int parse_size(const char *s, uint32_t *w, uint32_t *h)
+static int parse_uint(const char *s, uint32_t *out)
 {
-    char tail;
-    unsigned a, b;
-    if (sscanf(s, "%ux%u%c", &a, &b, &tail) != 2 || a == 0 || b == 0 || a > 16384 || b > 16384)
-        return 0;
-    *w = a;
-    *h = b;
+    return parse_u32_n(s, strlen(s), 0, UINT32_MAX, out);
+}
+
+/* count whole numbers in [lo, hi] separated by sep ("64x64", "16x16x16", "0:1"). */
+static int parse_u32_list(const char *s, char sep, int count, uint32_t lo, uint32_t hi,
+                          uint32_t *out)
+{
+    for (int i = 0; i < count; ++i) {
+        const char *end = i + 1 < count ? strchr(s, sep) : s + strlen(s);
+        if (!end || !parse_u32_n(s, (size_t)(end - s), lo, hi, &out[i]))
+            return 0;
+        s = end + 1;
+    }
     return 1;
+}
+
+/* The extension of path's last component, lower-cased into ext (size n); "" if none. */
+static void path_extension(const char *path, char *ext, size_t n)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t i = 0;
+    if (dot && dot != base)
+        for (const char *c = dot + 1; *c && i + 1 < n; ++c)
+            ext[i++] = (char)((*c >= 'A' && *c <= 'Z') ? *c - 'A' + 'a' : *c);
+    ext[i] = '\0';
+}
+
+/* The output must be writable before minutes go into the render: a .png or .exr name in an
+ * existing, writable directory, and not itself a directory. Returns 0, or prints and returns 1. */
+static int check_output(const char *path)
+{
+    char ext[8], dir[4096];
+    struct stat sb;
+    path_extension(path, ext, sizeof ext);
+    if (strcmp(ext, "png") != 0 && strcmp(ext, "exr") != 0) {
+        fprintf(stderr, "umbra-render: --out '%s': the extension must be .png or .exr\n", path);
+        return 1;
+    }
+    const char *slash = strrchr(path, '/');
+    if (!slash) {
+        snprintf(dir, sizeof dir, ".");
+    } else if (slash == path) {
+        snprintf(dir, sizeof dir, "/");
+    } else if ((size_t)(slash - path) < sizeof dir) {
+        memcpy(dir, path, (size_t)(slash - path));
+        dir[slash - path] = '\0';
+    } else {
+        fprintf(stderr, "umbra-render: --out: the directory name is longer than %zu bytes\n",
+                sizeof dir - 1);
+        return 1;
+    }
+    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
+        fprintf(stderr, "umbra-render: --out '%s': the directory '%s' does not exist\n", path,
+                dir);
+        return 1;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        fprintf(stderr, "umbra-render: --out '%s': the directory '%s' is not writable\n", path,
+                dir);
+        return 1;
+    }
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        fprintf(stderr, "umbra-render: --out '%s' is a directory\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+/* Exit status for a failed library call, as the README states: 1 for bad input (an argument out
+ * of range, a file that cannot be read or is malformed, a request the technique cannot do), 2 for
+ * a failure of the device or of memory. */
+static int exit_status(umbra_status st)
+{
+    switch (st) {
+    case UMBRA_SUCCESS: return 0;
+    case UMBRA_ERROR_INVALID_ARGUMENT:
+    case UMBRA_ERROR_IO:
+    case UMBRA_ERROR_FORMAT:
+    case UMBRA_ERROR_UNSUPPORTED: return 1;
+    default: return 2; /* OUT_OF_MEMORY, OPENCL, BUILD, NO_DEVICE */
+    }
 }
 
 static void on_error(void *user, umbra_status st, const char *msg)
@@ -148,6 +238,7 @@ static int on_progress(void *user, float fraction)
 
 typedef struct options {
     const char *scene, *volume, *raw, *tf, *tf_preset, *light_tf, *out, *device;
+    int platform_index, device_index; /* -1: not given */
     uint32_t scene_size, width, height;
     umbra_raw_desc raw_desc;
     int have_raw_dims, have_raw_type;
@@ -170,6 +261,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->out = "umbra.png";
     o->width = o->height = 512;
     o->fov = 30.0f;
+    o->platform_index = o->device_index = -1;
     o->shading = o->ground = o->colored = o->progress = -1;
     umbra_raw_desc_init(&o->raw_desc);
     umbra_shadow_desc_init(&o->shadow);
@@ -195,11 +287,8 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--raw")) { NEED(); o->raw = v; }
         else if (FLAG("--raw-dims")) {
             NEED();
-            char tail;
-            unsigned x, y, z;
-            if (sscanf(v, "%ux%ux%u%c", &x, &y, &z, &tail) != 3)
-                BAD("--raw-dims '%s' is not XxYxZ", v);
-            o->raw_desc.dims[0] = x; o->raw_desc.dims[1] = y; o->raw_desc.dims[2] = z;
+            if (!parse_u32_list(v, 'x', 3, 1, UINT32_MAX, o->raw_desc.dims))
+                BAD("--raw-dims '%s' is not XxYxZ with whole numbers in [1, %u]", v, UINT32_MAX);
             o->have_raw_dims = 1;
         } else if (FLAG("--raw-type")) {
             NEED();
@@ -217,7 +306,14 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--tf-preset")) { NEED(); o->tf_preset = v; }
         else if (FLAG("--light-tf")) { NEED(); o->light_tf = v; }
         else if (FLAG("--tf-range")) { NEED(); if (!parse_floats(v, o->tf_range, 2)) BAD("--tf-range '%s' is not LO,HI", v); o->have_tf_range = 1; }
-        else if (FLAG("--size")) { NEED(); if (!parse_size(v, &o->width, &o->height)) BAD("--size '%s' is not WxH with sides in [1, 16384]", v); }
+        else if (FLAG("--size")) {
+            NEED();
+            uint32_t wh[2];
+            if (!parse_u32_list(v, 'x', 2, 1, 16384, wh))
+                BAD("--size '%s' is not WxH with whole numbers in [1, 16384]", v);
+            o->width = wh[0];
+            o->height = wh[1];
+        }
         else if (FLAG("--out")) { NEED(); o->out = v; }
         else if (FLAG("--technique")) {
             NEED();
@@ -244,7 +340,19 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--grey")) o->colored = 0;
         else if (FLAG("--jitter")) o->jitter = 1;
         else if (FLAG("--seed")) { NEED(); if (!parse_uint(v, &o->seed)) BAD("--seed '%s' is not a whole number", v); o->have_seed = 1; o->shadow.seed = o->seed; }
-        else if (FLAG("--device")) { NEED(); o->device = v; }
+        else if (FLAG("--device")) {
+            /* P:D (platform and device indices) as the README documents, else a name substring. */
+            NEED();
+            uint32_t pd[2];
+            if (parse_u32_list(v, ':', 2, 0, 1023, pd)) {
+                o->platform_index = (int)pd[0];
+                o->device_index = (int)pd[1];
+            } else if (strchr(v, ':') && strspn(v, "0123456789:") == strlen(v)) {
+                BAD("--device '%s': P:D indices must be whole numbers in [0, 1023]", v);
+            } else {
+                o->device = v;
+            }
+        }
         else if (FLAG("--progress")) o->progress = 1;
         else if (FLAG("--no-progress")) o->progress = 0;
         else if (FLAG("--reference-step")) { NEED(); if (!parse_floats(v, &o->shadow.reference_step, 1)) BAD("--reference-step '%s' is not a number", v); }
@@ -269,7 +377,7 @@ static int parse_args(int argc, char **argv, options *o)
         BAD("--raw needs --raw-dims and --raw-type");
     if (o->have_light_dir && o->have_light_pos)
         BAD("--light-dir and --light-pos exclude each other");
-    return 0;
+    return check_output(o->out);
 }
 
 /* Everything the render needs; released in one place. */
@@ -313,9 +421,12 @@ static int run(const options *o, session *s)
     umbra_context_desc cd;
     umbra_context_desc_init(&cd);
     cd.device_name = o->device;
+    cd.platform_index = o->platform_index;
+    cd.device_index = o->device_index;
     cd.error_callback = on_error;
-    if (umbra_context_create(&cd, &s->ctx) != UMBRA_SUCCESS)
-        return 2;
+    umbra_status st = umbra_context_create(&cd, &s->ctx);
+    if (st != UMBRA_SUCCESS)
+        return exit_status(st);
     fprintf(stderr, "device: %s\n", umbra_context_device_name(s->ctx));
     double t0 = 0;
     (void)t0;
@@ -325,12 +436,11 @@ static int run(const options *o, session *s)
     umbra_render_desc_init(&rd);
     umbra_camera cam;
     umbra_light light;
-    int input_error = 0;
     if (o->volume || o->raw) {
-        umbra_status st = o->volume ? umbra_volume_load(s->ctx, o->volume, &s->volume)
-                                    : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
+        st = o->volume ? umbra_volume_load(s->ctx, o->volume, &s->volume)
+                       : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
         if (st != UMBRA_SUCCESS)
-            return 1;
+            return exit_status(st);
         vol = s->volume;
         umbra_volume_info info;
         umbra_volume_get_info(vol, &info);
@@ -351,13 +461,15 @@ static int run(const options *o, session *s)
             const umbra_tf_point pts[] = {{0.0f, {1, 1, 1, 0}}, {0.2f, {1, 1, 1, 0}},
                                           {0.5f, {0.9f, 0.8f, 0.7f, 0.05f}},
                                           {1.0f, {1, 1, 1, 0.4f}}};
-            if (umbra_transfer_function_create_from_points(s->ctx, pts, 4, 256, &s->tf))
-                return 2;
+            st = umbra_transfer_function_create_from_points(s->ctx, pts, 4, 256, &s->tf);
+            if (st != UMBRA_SUCCESS)
+                return exit_status(st);
             tf = s->tf;
         }
     } else {
-        if (umbra_scene_create(s->ctx, o->scene, o->scene_size, &s->scene) != UMBRA_SUCCESS)
-            return 1;
+        st = umbra_scene_create(s->ctx, o->scene, o->scene_size, &s->scene);
+        if (st != UMBRA_SUCCESS)
+            return exit_status(st);
         vol = s->scene.volume;
         tf = s->scene.tf;
         cam = s->scene.camera;
@@ -365,18 +477,21 @@ static int run(const options *o, session *s)
         rd = s->scene.options;
     }
     if (o->tf) {
-        if (load_tf(s->ctx, o->tf, o->tf_preset, &s->tf) != UMBRA_SUCCESS)
-            return 1;
+        st = load_tf(s->ctx, o->tf, o->tf_preset, &s->tf);
+        if (st != UMBRA_SUCCESS)
+            return exit_status(st);
         tf = s->tf;
     }
-    if (o->light_tf && load_tf(s->ctx, o->light_tf, o->tf_preset, &s->light_tf) != UMBRA_SUCCESS)
-        return 1;
+    if (o->light_tf &&
+        (st = load_tf(s->ctx, o->light_tf, o->tf_preset, &s->light_tf)) != UMBRA_SUCCESS)
+        return exit_status(st);
     /* The library checks LO < HI and names the values. */
     if (o->have_tf_range &&
-        (umbra_transfer_function_set_range(tf, o->tf_range[0], o->tf_range[1]) != UMBRA_SUCCESS ||
-         (s->light_tf &&
-          umbra_transfer_function_set_range(s->light_tf, o->tf_range[0], o->tf_range[1]) != UMBRA_SUCCESS)))
-        return 1;
+        ((st = umbra_transfer_function_set_range(tf, o->tf_range[0], o->tf_range[1])) !=
+             UMBRA_SUCCESS ||
+         (s->light_tf && (st = umbra_transfer_function_set_range(s->light_tf, o->tf_range[0],
+                                                                 o->tf_range[1])) != UMBRA_SUCCESS)))
+        return exit_status(st);
 
     if (o->have_camera_dir) {
         umbra_volume_info info;
@@ -412,16 +527,16 @@ static int run(const options *o, session *s)
     if (o->have_background) memcpy(rd.background, o->background, sizeof rd.background);
     else { rd.background[0] = 0.08f; rd.background[1] = 0.08f; rd.background[2] = 0.1f; rd.background[3] = 1.0f; }
 
-    if (umbra_renderer_create(s->ctx, &s->renderer) != UMBRA_SUCCESS)
-        return 2;
+    if ((st = umbra_renderer_create(s->ctx, &s->renderer)) != UMBRA_SUCCESS)
+        return exit_status(st);
     umbra_renderer r = s->renderer;
-    if (umbra_renderer_set_volume(r, vol) || umbra_renderer_set_transfer_function(r, tf) ||
-        (s->light_tf && umbra_renderer_set_light_transfer_function(r, s->light_tf)) ||
-        umbra_renderer_set_camera(r, &cam) || umbra_renderer_set_light(r, &light) ||
-        umbra_renderer_set_options(r, &rd) || umbra_renderer_set_shadow(r, &o->shadow))
-        input_error = 1;
-    if (input_error)
-        return 1;
+    if ((st = umbra_renderer_set_volume(r, vol)) ||
+        (st = umbra_renderer_set_transfer_function(r, tf)) ||
+        (s->light_tf && (st = umbra_renderer_set_light_transfer_function(r, s->light_tf))) ||
+        (st = umbra_renderer_set_camera(r, &cam)) || (st = umbra_renderer_set_light(r, &light)) ||
+        (st = umbra_renderer_set_options(r, &rd)) ||
+        (st = umbra_renderer_set_shadow(r, &o->shadow)))
+        return exit_status(st);
     s->pixels = malloc((size_t)o->width * o->height * 4 * sizeof(float));
     if (!s->pixels) {
         fprintf(stderr, "umbra-render: out of memory for a %ux%u image\n", o->width, o->height);
@@ -442,7 +557,7 @@ static int run(const options *o, session *s)
         return 130;
     }
     if (rst != UMBRA_SUCCESS)
-        return 2;
+        return exit_status(rst);
     umbra_render_stats stats;
     umbra_renderer_get_stats(r, &stats);
     fprintf(stderr, "technique: %s (%u light channel%s)\n",
@@ -454,6 +569,7 @@ static int run(const options *o, session *s)
     fprintf(stderr, "shadow memory: %zu bytes\n", stats.shadow_memory_bytes);
     if (stats.slices)
         fprintf(stderr, "slices: %u\n", stats.slices);
+    /* The path was checked before the render; failing now (a full disk) is not bad input. */
     if (umbra_image_write(s->ctx, o->out, o->width, o->height, s->pixels) != UMBRA_SUCCESS)
         return 2;
     fprintf(stderr, "wrote %s\n", o->out);

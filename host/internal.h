@@ -179,11 +179,4 @@ umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, f
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);
 
-/* ---- helpers shared by the I/O modules -------------------------------------------------------- */
-
-/* Reads a whole file into a malloc'ed buffer, followed by one NUL byte not counted in *size (the
- * text parsers rely on it). */
-umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *path, void **data,
-                              size_t *size);
-
 #endif

@@ -88,6 +88,10 @@ umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
     if (resolution < 2 || resolution > 65536)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: resolution %u must lie in [2, 65536]", fn, resolution);
+    if (count > UMBRA_TF_MAX_POINTS)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: count %u: at most %u control points are allowed", fn, count,
+                           UMBRA_TF_MAX_POINTS);
     for (uint32_t i = 0; i < count; ++i) {
         if (!(points[i].value >= 0.0f && points[i].value <= 1.0f))
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -104,9 +108,11 @@ umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
     float *table = malloc((size_t)resolution * 4 * sizeof *table);
     if (!table)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
+    /* One merge walk over entries and points: x only grows, so the first point at or above it
+     * (j) only moves forward, and the build costs resolution + count steps, not their product. */
+    uint32_t j = 0;
     for (uint32_t e = 0; e < resolution; ++e) {
         float x = (float)e / (float)(resolution - 1);
-        uint32_t j = 0;
         while (j < count && points[j].value < x)
             ++j;
         for (int c = 0; c < 4; ++c) {

@@ -165,12 +165,14 @@ umbra_status write_exr(umbra_context ctx, const char *path, uint32_t width, uint
 umbra_status read_image(umbra_context ctx, const char *path, image_kind kind, uint32_t *width,
                         uint32_t *height, float **rgba)
 {
-    // Tell a file that cannot be opened (an I/O error) from one OpenImageIO cannot parse.
-    std::FILE *probe = std::fopen(path, "rb");
-    if (!probe) {
-        int err = errno;
-        return umbra__fail(ctx, UMBRA_ERROR_IO, "umbra_image_read: cannot open \"%s\": %s", path,
-                           std::strerror(err));
+    // Tell a file that cannot be opened (an I/O error) from one OpenImageIO cannot parse, and
+    // refuse anything but a regular file before OpenImageIO opens it by name: a FIFO would block
+    // it forever.
+    std::FILE *probe = nullptr;
+    std::size_t probe_size = 0;
+    umbra_status st = umbra__file_open(ctx, "umbra_image_read", path, &probe, &probe_size);
+    if (st != UMBRA_SUCCESS) {
+        return st;
     }
     std::fclose(probe);
 

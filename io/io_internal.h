@@ -10,6 +10,7 @@
 
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "umbra/io.h"
@@ -41,10 +42,38 @@ static inline umbra_status umbra__fail(umbra_context ctx, umbra_status status, c
     return umbra_context_record_error(ctx, status, message);
 }
 
-/* Reads a whole regular file into a malloc'ed buffer, followed by one NUL byte not counted in
- * *size (the text parsers rely on it). func names the public function in messages. */
+/* Reads a whole file into a malloc'ed buffer, followed by one NUL byte not counted in *size (the
+ * text parsers rely on it). Regular files only (see umbra__file_open). */
 umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *path, void **data,
                               size_t *size);
+
+/* Opens path for reading if it is a regular file, without ever blocking (a FIFO or device is
+ * refused, not waited on), and gives its size. The FILE is the caller's to fclose. Every reader of
+ * umbra opens its files through this. func names the public function in messages. */
+umbra_status umbra__file_open(umbra_context ctx, const char *func, const char *path, FILE **out,
+                              size_t *size);
+
+/* Reads exactly size bytes of f (which is path) into dst, or fails naming how many came. */
+umbra_status umbra__file_read(umbra_context ctx, const char *func, const char *path, FILE *f,
+                              void *dst, size_t size);
+
+/* strerror_r into buf; thread-safe. */
+const char *umbra__errno_text(int err, char *buf, size_t n);
+
+/* The one integer parser of the file readers: the n characters at s must be decimal digits only
+ * (no sign, blank or other trailing text) and the value at most max. Returns 1 and sets *out, else
+ * 0 (also on overflow). */
+int umbra__parse_uint(const char *s, size_t n, uint64_t max, uint64_t *out);
+
+int umbra__host_is_big_endian(void);
+void umbra__swap_bytes(void *data, size_t count, size_t width);
+
+/* Hands voxels in host memory (copied) to umbra_volume_create; origin and directions (9 floats,
+ * unit axis directions) give the index-to-world transform, or are NULL for the centred box. */
+umbra_status umbra__volume_from_host(umbra_context ctx, const void *data, umbra_scalar_type type,
+                                     const uint32_t dims[3], const float spacing[3],
+                                     const float *origin, const float *directions,
+                                     umbra_volume *out);
 
 #ifdef __cplusplus
 }

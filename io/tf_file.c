@@ -8,7 +8,8 @@
  *                             spans LO..HI (umbra_transfer_function_set_range)
  *     0.00  0 0 0 0           control points "value r g b a", colour in [0,1], value in [0,1]
  *     0.35  1 0.8 0.6 0.05    (or [LO, HI]), values ascending (equal values make a step)
- * Blank lines are ignored; at least one point is required. The table itself is built by
+ * Blank lines are ignored; at least one point is required and at most 65536 are allowed
+ * (UMBRA_TF_MAX_POINTS); the table build is linear in points + resolution. The table is built by
  * umbra_transfer_function_create_from_points. Numbers are parsed in the "C" locale, so a decimal
  * point is a '.' whatever locale the application has set. */
 #define _POSIX_C_SOURCE 200809L
@@ -148,8 +149,6 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
         }
 
         if (tok[0].n == 10 && memcmp(tok[0].s, "resolution", 10) == 0) {
-            long long r = 0;
-            char *rend = NULL;
             if (have_resolution || count > 0) {
                 st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                                  "%s: %s:%lu: \"%.*s\": resolution must be given once, before the "
@@ -157,12 +156,9 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                  __func__, path, line_no, QUOTE_MAX, line);
                 goto fail;
             }
-            if (ntok == 2) {
-                errno = 0;
-                r = strtoll(tok[1].s, &rend, 10);
-            }
-            if (ntok != 2 || rend != tok[1].s + tok[1].n || errno == ERANGE ||
-                r < TF_MIN_RESOLUTION || r > TF_MAX_RESOLUTION) {
+            uint64_t r = 0;
+            if (ntok != 2 || !umbra__parse_uint(tok[1].s, tok[1].n, TF_MAX_RESOLUTION, &r) ||
+                r < TF_MIN_RESOLUTION) {
                 st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                                  "%s: %s:%lu: \"%.*s\": expected \"resolution N\" with an "
                                  "integer N in %d..%d",
@@ -210,14 +206,15 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                              __func__, path, line_no, QUOTE_MAX, line, ntok);
             goto fail;
         }
+        if (count == UMBRA_TF_MAX_POINTS) {
+            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                             "%s: %s:%lu: control point %zu: at most %u are allowed", __func__,
+                             path, line_no, count + 1, UMBRA_TF_MAX_POINTS);
+            goto fail;
+        }
         if (count == capacity) {
             size_t grown = capacity ? 2 * capacity : 16;
             umbra_tf_point *p;
-            if (grown > UINT32_MAX) {
-                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: %s:%lu: too many control points",
-                                 __func__, path, line_no);
-                goto fail;
-            }
             p = realloc(points, grown * sizeof *points);
             if (!p) {
                 st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,

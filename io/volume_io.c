@@ -1,16 +1,14 @@
 /* io/volume_io.c: reading volumes from files.
  *
- * Three readers, all ending in umbra_volume_create: NRRD through Teem (attached .nrrd or detached
- * .nhdr), Voreen's .dat text header over a raw file, and plain headerless raw files described by
- * an umbra_raw_desc. Also the whole-file reader the other I/O modules share.
- *
- * Teem keeps its errors in a process-wide store (biff) and reads the global nrrdStateVerboseIO to
- * decide whether to print. Both are wrong for a library inside another program, so every Teem call
- * runs under one lock, with verbosity off, and its error text is moved straight into the context's
- * message and freed. Text is parsed in the "C" numeric locale whatever the application has set. */
+ * Two readers, both ending in umbra_volume_create: Voreen's .dat text header over a raw file, and
+ * plain headerless raw files described by an umbra_raw_desc (NRRD lives in io_nrrd.c). Also what
+ * every file reader shares: the one way files are opened (regular files only, never blocking on
+ * a FIFO or device), the whole-file reader, strict integer parsing and byte swapping. Text is
+ * parsed in the "C" numeric locale whatever the application has set. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <locale.h>
 #include <math.h>
@@ -21,8 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
-
-#include <teem/nrrd.h>
+#include <unistd.h>
 
 #include "io_internal.h"
 
@@ -31,7 +28,7 @@
 
 /* ---- files -------------------------------------------------------------------------------- */
 
-static const char *errno_text(int err, char *buf, size_t n)
+const char *umbra__errno_text(int err, char *buf, size_t n)
 {
     /* strerror_r (XSI form under _POSIX_C_SOURCE) rather than strerror, which may share a
      * static buffer between threads. */
@@ -41,32 +38,55 @@ static const char *errno_text(int err, char *buf, size_t n)
     return buf;
 }
 
-/* Opens a regular file for reading and returns its size. Refusing directories and devices here
- * gives a clear message instead of a puzzling failure in fread. */
-static umbra_status file_open(umbra_context ctx, const char *func, const char *path, FILE **out,
+/* Opens a regular file for reading and returns its size. The open is non-blocking, so a FIFO or
+ * a device named as an input cannot block the caller (a plain fopen of a FIFO waits forever for a
+ * writer); the file's type is then taken from the descriptor itself (fstat, no race with a
+ * rename), anything but a regular file is refused, and only then is the descriptor made blocking
+ * again for ordinary reads. */
+umbra_status umbra__file_open(umbra_context ctx, const char *func, const char *path, FILE **out,
                               size_t *size)
 {
     char buf[256];
     struct stat sb;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    FILE *f = NULL;
+    int fd, flags;
+
+    *out = NULL;
+    *size = 0;
+    fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) {
         return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\": %s", func, path,
-                           errno_text(errno, buf, sizeof buf));
+                           umbra__errno_text(errno, buf, sizeof buf));
     }
-    if (fstat(fileno(f), &sb) != 0) {
+    if (fstat(fd, &sb) != 0) {
         int err = errno;
-        fclose(f);
+        close(fd);
         return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot stat \"%s\": %s", func, path,
-                           errno_text(err, buf, sizeof buf));
+                           umbra__errno_text(err, buf, sizeof buf));
     }
     if (!S_ISREG(sb.st_mode)) {
-        fclose(f);
-        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: \"%s\" is not a regular file", func, path);
+        close(fd);
+        return umbra__fail(ctx, UMBRA_ERROR_IO,
+                           "%s: \"%s\" is not a regular file (a %s); only regular files are read",
+                           func, path,
+                           S_ISDIR(sb.st_mode)   ? "directory"
+                           : S_ISFIFO(sb.st_mode) ? "FIFO"
+                           : S_ISCHR(sb.st_mode)  ? "character device"
+                           : S_ISBLK(sb.st_mode)  ? "block device"
+                           : S_ISSOCK(sb.st_mode) ? "socket"
+                                                  : "special file");
     }
     if (sb.st_size < 0 || (uintmax_t)sb.st_size >= SIZE_MAX) {
-        fclose(f);
+        close(fd);
         return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: \"%s\" is too large to read (%jd bytes)",
                            func, path, (intmax_t)sb.st_size);
+    }
+    flags = fcntl(fd, F_GETFL);
+    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 || !(f = fdopen(fd, "rb"))) {
+        int err = errno;
+        close(fd);
+        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\": %s", func, path,
+                           umbra__errno_text(err, buf, sizeof buf));
     }
     *out = f;
     *size = (size_t)sb.st_size;
@@ -74,7 +94,7 @@ static umbra_status file_open(umbra_context ctx, const char *func, const char *p
 }
 
 /* Reads exactly size bytes from f, which is path, into dst. */
-static umbra_status file_read(umbra_context ctx, const char *func, const char *path, FILE *f,
+umbra_status umbra__file_read(umbra_context ctx, const char *func, const char *path, FILE *f,
                               void *dst, size_t size)
 {
     char buf[256];
@@ -82,7 +102,7 @@ static umbra_status file_read(umbra_context ctx, const char *func, const char *p
     if (got != size) {
         if (ferror(f)) {
             return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot read \"%s\": %s", func, path,
-                               errno_text(errno, buf, sizeof buf));
+                               umbra__errno_text(errno, buf, sizeof buf));
         }
         return umbra__fail(ctx, UMBRA_ERROR_IO,
                            "%s: \"%s\" ended after %zu of %zu bytes (changed while reading?)",
@@ -109,7 +129,7 @@ umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *p
     if (!path) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", func);
     }
-    st = file_open(ctx, func, path, &f, &n);
+    st = umbra__file_open(ctx, func, path, &f, &n);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
@@ -119,7 +139,7 @@ umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *p
                          func, n + 1, path);
         goto fail;
     }
-    st = file_read(ctx, func, path, f, buf, n);
+    st = umbra__file_read(ctx, func, path, f, buf, n);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
@@ -138,6 +158,24 @@ fail:
 }
 
 /* ---- small helpers ------------------------------------------------------------------------ */
+
+int umbra__parse_uint(const char *s, size_t n, uint64_t max, uint64_t *out)
+{
+    uint64_t v = 0;
+    size_t i;
+    if (!s || n == 0) {
+        return 0;
+    }
+    for (i = 0; i < n; ++i) {
+        unsigned d = (unsigned)((unsigned char)s[i] - '0');
+        if (d > 9 || d > max || v > (max - d) / 10) {
+            return 0;
+        }
+        v = 10 * v + d;
+    }
+    *out = v;
+    return 1;
+}
 
 static int ascii_lower(int c)
 {
@@ -171,7 +209,7 @@ static const char *path_extension(const char *path)
     return (dot && dot != base) ? dot + 1 : "";
 }
 
-static int host_is_big_endian(void)
+int umbra__host_is_big_endian(void)
 {
     const uint16_t one = 1;
     unsigned char first;
@@ -179,7 +217,7 @@ static int host_is_big_endian(void)
     return first == 0;
 }
 
-static void swap_bytes(void *data, size_t count, size_t width)
+void umbra__swap_bytes(void *data, size_t count, size_t width)
 {
     unsigned char *p = data;
     size_t i, j;
@@ -234,7 +272,7 @@ void umbra_raw_desc_init(umbra_raw_desc *desc)
 
 /* Hands voxels already in host memory to umbra_volume_create; origin and directions (9 floats,
  * unit axis directions) give the index-to-world transform, or are NULL for the centred box. */
-static umbra_status create_volume(umbra_context ctx, const void *data, umbra_scalar_type type,
+umbra_status umbra__volume_from_host(umbra_context ctx, const void *data, umbra_scalar_type type,
                                   const uint32_t dims[3], const float spacing[3],
                                   const float *origin, const float *directions, umbra_volume *out)
 {
@@ -299,7 +337,7 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     expected = desc->header_bytes + data_bytes;
 
     /* Check the size before reading, so a wrong header costs nothing on a large file. */
-    st = file_open(ctx, func, path, &f, &file_size);
+    st = umbra__file_open(ctx, func, path, &f, &file_size);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
@@ -314,7 +352,7 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     if (desc->header_bytes > 0 && fseeko(f, (off_t)desc->header_bytes, SEEK_SET) != 0) {
         char buf[256];
         st = umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot skip %zu header bytes of \"%s\": %s",
-                         func, desc->header_bytes, path, errno_text(errno, buf, sizeof buf));
+                         func, desc->header_bytes, path, umbra__errno_text(errno, buf, sizeof buf));
         goto fail;
     }
     voxels = malloc(data_bytes);
@@ -324,16 +362,17 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
                          data_bytes, path);
         goto fail;
     }
-    st = file_read(ctx, func, path, f, voxels, data_bytes);
+    st = umbra__file_read(ctx, func, path, f, voxels, data_bytes);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
     fclose(f);
     f = NULL;
-    if (type_size > 1 && (desc->big_endian != 0) != host_is_big_endian()) {
-        swap_bytes(voxels, count, type_size);
+    if (type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()) {
+        umbra__swap_bytes(voxels, count, type_size);
     }
-    st = create_volume(ctx, voxels, desc->type, desc->dims, desc->spacing, NULL, NULL, out);
+    st = umbra__volume_from_host(ctx, voxels, desc->type, desc->dims, desc->spacing, NULL, NULL,
+                                 out);
 
 fail:
     free(voxels);
@@ -367,205 +406,35 @@ umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const um
     return load_raw(ctx, __func__, path, desc, out);
 }
 
-/* ---- NRRD --------------------------------------------------------------------------------- */
-
-/* Serialises umbra's use of Teem's process-wide state (biff, nrrdStateVerboseIO). It is the one
- * mutable global here, and it exists to contain someone else's. */
-static pthread_mutex_t teem_lock = PTHREAD_MUTEX_INITIALIZER;
-
-/* Turns biff's "[nrrd] a\n[nrrd] b\n" into "a; b" in place. */
-static void flatten_biff(char *msg)
-{
-    char *src = msg, *dst = msg;
-    while (*src) {
-        if (strncmp(src, "[nrrd] ", 7) == 0) {
-            src += 7;
-        }
-        while (*src && *src != '\n') {
-            *dst++ = *src++;
-        }
-        while (*src == '\n') {
-            ++src;
-        }
-        if (*src) {
-            *dst++ = ';';
-            *dst++ = ' ';
-        }
-    }
-    *dst = '\0';
-}
-
-/* World units between samples along one axis: the axis spacing, else the length of its space
- * direction, else 1. */
-static float nrrd_axis_spacing(const Nrrd *nrrd, unsigned int axis)
-{
-    double s = nrrd->axis[axis].spacing;
-    if (isfinite(s) && s != 0.0) {
-        return (float)fabs(s);
-    }
-    if (nrrd->spaceDim > 0) {
-        s = nrrdSpaceVecNorm(nrrd->spaceDim, nrrd->axis[axis].spaceDirection);
-        if (isfinite(s) && s > 0.0) {
-            return (float)s;
-        }
-    }
-    return 1.0f;
-}
-
-/* The index-to-world transform of a 3-D space: the space origin (0 where absent) and each axis's
- * unit space direction, with the directions' lengths as the spacing. Returns 0 (centred box) when
- * the header has no 3-D space or some axis lacks a finite, non-zero direction. */
-static int nrrd_transform(const Nrrd *nrrd, unsigned int first_axis, float spacing[3],
-                          float origin[3], float directions[9])
-{
-    if (nrrd->spaceDim != 3) {
-        return 0;
-    }
-    for (unsigned int a = 0; a < 3; ++a) {
-        const double *d = nrrd->axis[first_axis + a].spaceDirection;
-        double len = nrrdSpaceVecNorm(3, d);
-        if (!isfinite(len) || !(len > 0.0)) {
-            return 0;
-        }
-        spacing[a] = (float)len;
-        for (unsigned int k = 0; k < 3; ++k) {
-            directions[3 * a + k] = (float)(d[k] / len);
-        }
-    }
-    for (unsigned int k = 0; k < 3; ++k) {
-        origin[k] = isfinite(nrrd->spaceOrigin[k]) ? (float)nrrd->spaceOrigin[k] : 0.0f;
-    }
-    return 1;
-}
-
-/* A 4-D array whose first axis has size 1 (a one-component "vector" volume, as some tools
- * write) is accepted as the 3-D volume it is. */
-umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
-{
-    umbra_status st = UMBRA_SUCCESS;
-    Nrrd *nrrd = NULL;
-    char *biff_msg = NULL;
-    umbra_scalar_type type = UMBRA_UINT8;
-    uint32_t dims[3];
-    float spacing[3], origin[3], directions[9];
-    unsigned int first_axis = 0, i;
-    int load_failed, verbose;
-    locale_switch loc;
-    FILE *probe;
-
-    if (!out) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
-    }
-    *out = NULL;
-    if (!ctx) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
-    }
-    if (!path) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
-    }
-    /* A file that cannot be opened is an I/O error; Teem would report it as a parse failure. */
-    probe = fopen(path, "rb");
-    if (!probe) {
-        char buf[256];
-        return umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\": %s", __func__, path,
-                           errno_text(errno, buf, sizeof buf));
-    }
-    fclose(probe);
-
-    nrrd = nrrdNew();
-    if (!nrrd) {
-        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: nrrdNew failed for \"%s\"",
-                         __func__, path);
-        goto fail;
-    }
-    pthread_mutex_lock(&teem_lock);
-    verbose = nrrdStateVerboseIO;
-    nrrdStateVerboseIO = 0;
-    loc = locale_use_c();
-    load_failed = nrrdLoad(nrrd, path, NULL);
-    locale_restore(loc);
-    nrrdStateVerboseIO = verbose;
-    if (load_failed) {
-        biff_msg = biffGetDone(NRRD);
-    }
-    pthread_mutex_unlock(&teem_lock);
-    if (load_failed) {
-        if (biff_msg) {
-            flatten_biff(biff_msg);
-        }
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: cannot read \"%s\": %s", __func__, path,
-                         biff_msg ? biff_msg : "Teem gave no reason");
-        goto fail;
-    }
-
-    switch (nrrd->type) {
-    case nrrdTypeUChar: type = UMBRA_UINT8; break;
-    case nrrdTypeUShort: type = UMBRA_UINT16; break;
-    case nrrdTypeShort: type = UMBRA_INT16; break;
-    case nrrdTypeFloat: type = UMBRA_FLOAT32; break;
-    default:
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                         "%s: \"%s\" has type %s; supported are uchar, ushort, short and float",
-                         __func__, path, airEnumStr(nrrdType, nrrd->type));
-        goto fail;
-    }
-    if (nrrd->dim == 4 && nrrd->axis[0].size == 1) {
-        first_axis = 1;
-    } else if (nrrd->dim != 3) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                         "%s: \"%s\" has dimension %u; a volume must have 3 (or 4 with a first "
-                         "axis of size 1)",
-                         __func__, path, nrrd->dim);
-        goto fail;
-    }
-    for (i = 0; i < 3; ++i) {
-        size_t size = nrrd->axis[first_axis + i].size;
-        if (size == 0 || size > UINT32_MAX) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": axis %u has size %zu",
-                             __func__, path, first_axis + i, size);
-            goto fail;
-        }
-        dims[i] = (uint32_t)size;
-        spacing[i] = nrrd_axis_spacing(nrrd, first_axis + i);
-    }
-    /* The world is the header's space as written (e.g. LPS for DICOM-derived scans). */
-    if (nrrd_transform(nrrd, first_axis, spacing, origin, directions)) {
-        st = create_volume(ctx, nrrd->data, type, dims, spacing, origin, directions, out);
-    } else {
-        st = create_volume(ctx, nrrd->data, type, dims, spacing, NULL, NULL, out);
-    }
-
-fail:
-    free(biff_msg);
-    if (nrrd) {
-        nrrdNuke(nrrd);
-    }
-    return st;
-}
-
 /* ---- Voreen .dat ------------------------------------------------------------------------ */
 
-/* Parses exactly n numbers separated by blanks from s (NUL-terminated). Integers when ints is
- * set (into u), else floats (into f). Returns 0 on any stray text. */
-static int parse_numbers(const char *s, int n, int ints, unsigned long *u, float *f)
+/* Parses exactly n numbers separated by blanks from s (NUL-terminated). Integers (at most
+ * UINT32_MAX) when ints is set (into u), else floats (into f). Returns 0 on any stray text. */
+static int parse_numbers(const char *s, int n, int ints, uint64_t *u, float *f)
 {
     int i;
     for (i = 0; i < n; ++i) {
-        char *end = NULL;
+        const char *end = s;
         while (is_space(*s)) {
             ++s;
         }
         if (*s == '\0' || *s == '-' || *s == '+') {
             return 0;
         }
-        errno = 0;
         if (ints) {
-            u[i] = strtoul(s, &end, 10);
+            for (end = s; *end != '\0' && !is_space(*end); ++end) {
+            }
+            if (!umbra__parse_uint(s, (size_t)(end - s), UINT32_MAX, &u[i])) {
+                return 0;
+            }
         } else {
-            f[i] = strtof(s, &end);
-        }
-        if (end == s || errno == ERANGE || (*end != '\0' && !is_space(*end))) {
-            return 0;
+            char *fend = NULL;
+            errno = 0;
+            f[i] = strtof(s, &fend);
+            end = fend;
+            if (end == s || errno == ERANGE || (*end != '\0' && !is_space(*end))) {
+                return 0;
+            }
         }
         s = end;
     }
@@ -582,7 +451,7 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
     void *buf = NULL;
     size_t size = 0;
     const char *object_file = NULL, *resolution = NULL, *thickness = NULL, *format = NULL;
-    unsigned long res[3] = {0, 0, 0};
+    uint64_t res[3] = {0, 0, 0};
     umbra_raw_desc raw;
     locale_switch loc;
     int ok, i;

@@ -532,7 +532,8 @@ static void test_nrrd_broken_header_is_format_error(void **state)
     remove(path);
 }
 
-static void test_nrrd_missing_data_file_is_format_error(void **state)
+/* Like the .dat reader's raw file: a data file that cannot be opened is an I/O error. */
+static void test_nrrd_missing_data_file_is_io_error(void **state)
 {
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
@@ -543,8 +544,8 @@ static void test_nrrd_missing_data_file_is_format_error(void **state)
                                               "sizes: 2 2 2\n"
                                               "encoding: raw\n"
                                               "data file: orphan_absent.raw\n");
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT, path,
-                  "orphan_absent.raw");
+    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_IO,
+                  "orphan_absent.raw", "No such file");
     assert_int_equal(biffCheck(NRRD), 0);
     remove(path);
 }
@@ -1335,7 +1336,7 @@ int main(void)
         IO_TEST(test_nrrd_space_origin_and_directions_give_world),
         IO_TEST(test_nrrd_4d_with_leading_size1_axis_loads),
         IO_TEST(test_nrrd_broken_header_is_format_error),
-        IO_TEST(test_nrrd_missing_data_file_is_format_error),
+        IO_TEST(test_nrrd_missing_data_file_is_io_error),
         IO_TEST(test_nrrd_missing_file_is_io_error),
         IO_TEST(test_nrrd_unsupported_type_names_type),
         IO_TEST(test_nrrd_2d_is_format_error),

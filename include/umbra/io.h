@@ -24,15 +24,20 @@ extern "C" {
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .dat (Voreen). */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads NRRD, attached (.nrrd) or detached (.nhdr + data file), through Teem: types uchar, ushort,
- * short and float; 3-D, or 4-D with a size-1 first axis. With "space directions" the spacing is
- * each direction's length and the volume carries the index-to-world transform (space origin, 0
- * where absent, and the unit directions); a sheared grid is UMBRA_ERROR_UNSUPPORTED. Without them
- * the spacing comes from the header's spacings (1 where absent) and the box is centred. */
+/* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
+ * absolute): types uchar, ushort, short and float; 3-D, or 4-D with a size-1 first axis; encodings
+ * raw, gzip, zrl, ascii and hex. With "space directions" the spacing is each direction's length
+ * and the volume carries the index-to-world transform (space origin, 0 where absent, and the unit
+ * directions); a sheared grid is UMBRA_ERROR_UNSUPPORTED. Without them the spacing comes from the
+ * header's spacings (1 where absent) and the box is centred. Teem parses the header, umbra reads
+ * the data. Header and data must be regular files (a FIFO or device is UMBRA_ERROR_IO, never
+ * waited on); the declared sizes are checked against the data before anything is allocated: raw
+ * data must fill the rest of its file exactly, gzip can expand at most 1032:1 and zrl 16384:1
+ * (else UMBRA_ERROR_FORMAT naming both sizes). */
 UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads a Voreen .dat header and its raw file, which is looked up relative to the .dat's
- * directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
+/* Loads a Voreen .dat header and its raw file (both regular files), which is looked up relative
+ * to the .dat's directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
  * are required; ObjectModel, if present, must be I. SliceThickness is the spacing; the format
  * has no origin, so the box is centred. */
 UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
@@ -60,7 +65,7 @@ typedef struct umbra_raw_desc {
 /* Fills desc with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_raw_desc_init(umbra_raw_desc *desc);
 
-/* Loads a headerless raw file. The file must hold exactly header_bytes + dims product * type size
+/* Loads a headerless raw file (a regular file, else UMBRA_ERROR_IO). The file must hold exactly header_bytes + dims product * type size
  * bytes; any other size is UMBRA_ERROR_FORMAT naming both numbers. */
 UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
                                              umbra_volume *out);
@@ -68,10 +73,11 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
 /* ---- transfer functions ---------------------------------------------------------------------- */
 
 /* Reads the text format documented in the README (and io/tf_file.c): '#' comments, optional
- * lines "resolution N" (default 256) and "range LO HI" (finite, LO < HI) before the first point,
- * then one control point "value r g b a" per line, values ascending (equal values make a step):
- * in [0,1] of the volume's normalised range, or with a range, data values in [LO, HI].
- * UMBRA_ERROR_FORMAT names the line and value for anything else. A path ending in .json is read
+ * lines "resolution N" (2..65536, default 256) and "range LO HI" (finite, LO < HI) before the
+ * first point, then one control point "value r g b a" per line (at most UMBRA_TF_MAX_POINTS),
+ * values ascending (equal values make a step): in [0,1] of the volume's normalised range, or with
+ * a range, data values in [LO, HI]. The file must be a regular file; errors are UMBRA_ERROR_IO or
+ * UMBRA_ERROR_FORMAT naming path:line and the value. A path ending in .json is read
  * as a ParaView preset with umbra_transfer_function_load_paraview's defaults. */
 UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                                     umbra_transfer_function *out);

@@ -36,8 +36,12 @@ typedef struct umbra_tf_point {
     float rgba[4];
 } umbra_tf_point;
 
-/* Builds a table of resolution entries by linear interpolation between points (sorted by value,
- * at least one). Values outside the first and last point take those points' colours. */
+/* The most control points a transfer function is built from, and the most table entries. */
+#define UMBRA_TF_MAX_POINTS 65536u
+
+/* Builds a table of resolution entries (2..UMBRA_TF_MAX_POINTS) by linear interpolation between
+ * points (sorted by value, 1..UMBRA_TF_MAX_POINTS of them; more is UMBRA_ERROR_INVALID_ARGUMENT).
+ * Values outside the first and last point take those points' colours. Copies points. */
 UMBRA_API umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
                                                                   const umbra_tf_point *points,
                                                                   uint32_t count, uint32_t resolution,

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# tests/cli/exit_codes.sh UMBRA_RENDER: umbra-render's exit statuses and strict number parsing
+# against the README ("bad input exits 1 with a message naming the problem; a failure on the
+# device exits 2"), issue 11 rows 2, 10 and 11. Each case runs the CLI on a tiny image and checks
+# the status, a piece of the message, and for output paths that nothing was rendered first.
+set -uo pipefail
+render=$(realpath "${1:?usage: exit_codes.sh path/to/umbra-render}")
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" # a case that wrongly succeeds writes its default umbra.png here, not into the tree
+failures=0
+small=(--scene-size 16 --size 16x16)
+
+# expect STATUS NEEDLE [--no-render] -- ARGS...: runs umbra-render ARGS (20 s at most: a FIFO
+# that blocks shows as a timeout) and checks its exit status and that stderr holds NEEDLE.
+expect() {
+    local want=$1 needle=$2 no_render=0
+    shift 2
+    if [[ $1 == --no-render ]]; then no_render=1; shift; fi
+    [[ $1 == -- ]] && shift
+    timeout 20 "$render" "$@" >"$tmp/out" 2>"$tmp/err"
+    local got=$?
+    local ok=1
+    [[ $got -eq $want ]] || ok=0
+    grep -qF -- "$needle" "$tmp/err" || ok=0
+    if [[ $no_render -eq 1 ]] && grep -q '^render:\|^device:' "$tmp/err"; then ok=0; fi
+    if [[ $ok -eq 0 ]]; then
+        echo "FAIL: umbra-render $* -> exit $got (want $want), stderr:"
+        sed 's/^/    /' "$tmp/err"
+        echo "    (looked for: $needle)"
+        failures=$((failures + 1))
+        return 1
+    fi
+    echo "ok:   exit $got: umbra-render $*"
+}
+
+# Row 10: --device P:D is the documented index form, not a name.
+expect 0 "wrote" -- "${small[@]}" --device 0:0 --out "$tmp/a.png"
+expect 1 "P:D indices must be whole numbers in [0, 1023]" -- --device 0:4294967296
+expect 2 "UMBRA_ERROR_NO_DEVICE" -- "${small[@]}" --device 7:7 --out "$tmp/a.png"
+# Row 10: output paths are checked before anything is rendered, and are bad input.
+expect 1 "the extension must be .png or .exr" --no-render -- "${small[@]}" --out "$tmp/a.jpg"
+expect 1 "does not exist" --no-render -- "${small[@]}" --out "$tmp/no/such/dir/a.png"
+mkdir "$tmp/dir.png"
+expect 1 "is a directory" --no-render -- "${small[@]}" --out "$tmp/dir.png"
+# Row 10: a request the technique cannot do, found at render time, is bad input too.
+expect 1 "UMBRA_ERROR_UNSUPPORTED" -- "${small[@]}" --technique convolution --light-dir 0,0,1 \
+    --out "$tmp/a.png"
+expect 1 "UMBRA_ERROR_INVALID_ARGUMENT" -- "${small[@]}" --technique deep --map-size 9 \
+    --out "$tmp/a.png"
+# Row 10: out of memory is a failure (2) wherever it happens, also while loading the volume. A
+# sparse 4 GiB file (no disk used) under a 3 GB address-space limit makes the voxel buffer fail.
+if truncate -s 4G "$tmp/big.raw" 2>/dev/null; then
+    (ulimit -v 3000000 && expect 2 "UMBRA_ERROR_OUT_OF_MEMORY" -- --raw "$tmp/big.raw" \
+        --raw-dims 2048x2048x1024 --raw-type uint8 --size 16x16 --out "$tmp/a.png") ||
+        failures=$((failures + 1))
+    rm -f "$tmp/big.raw"
+fi
+# Row 11: whole numbers are parsed strictly: no wrap-around, no sign, no trailing text.
+expect 1 "--raw-dims '4294967312x16x16' is not XxYxZ" -- --raw "$tmp/a.raw" \
+    --raw-dims 4294967312x16x16 --raw-type uint8
+expect 1 "--raw-dims '-1x16x16' is not XxYxZ" -- --raw "$tmp/a.raw" --raw-dims -1x16x16 \
+    --raw-type uint8
+expect 1 "--size '4294967360x64' is not WxH with whole numbers in [1, 16384]" -- \
+    --size 4294967360x64
+expect 1 "--size '64x64junk'" -- --size 64x64junk
+expect 1 "--size ' 64x64'" -- --size " 64x64"
+expect 1 "--size '+64x64'" -- --size +64x64
+expect 1 "--seed '4294967296' is not a whole number" -- --seed 4294967296
+expect 1 "--seed '-1' is not a whole number" -- --seed -1
+expect 1 "--scene-size '16 ' is not a whole number" -- --scene-size "16 "
+# Row 2: a FIFO as an input is refused at once (exit 1), not waited on (timeout: exit 124).
+mkfifo "$tmp/fifo"
+expect 1 "not a regular file" -- "${small[@]}" --tf "$tmp/fifo" --out "$tmp/a.png"
+expect 1 "not a regular file" -- --raw "$tmp/fifo" --raw-dims 2x2x2 --raw-type uint8 \
+    --size 16x16 --out "$tmp/a.png"
+ln -s "$tmp/fifo" "$tmp/fifo.nrrd"
+expect 1 "not a regular file" -- --volume "$tmp/fifo.nrrd" --size 16x16 --out "$tmp/a.png"
+
+if [[ $failures -ne 0 ]]; then
+    echo "$failures case(s) failed"
+    exit 1
+fi
+echo "all cases passed"
