@@ -3,7 +3,9 @@
  *
  * Nothing is rebuilt per frame unless its inputs changed: step-corrected transfer-function tables
  * and brick visibility are keyed by (table id, volume id, step); the shadow structure by the full
- * light key (umbra__light_key); programs by their sources and options (context cache). */
+ * light key (umbra__light_key); programs by their sources and options (context cache). The
+ * tables live in host/tables.c, the frame constants in host/frame.c, rendering into the
+ * application's cl_mem in host/render_cl.c, progress and banded launches in host/progress.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -102,26 +104,6 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
 
 /* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
  * (0, -1e20, 0) would get length inf and normalise to zero), never a double. */
-static double len3d(const float v[3])
-{
-    return sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
-}
-
-static void normalize3(float v[3])
-{
-    double l = len3d(v);
-    if (l > 0.0)
-        for (int i = 0; i < 3; ++i)
-            v[i] = (float)(v[i] / l);
-}
-
-static void cross3(const float a[3], const float b[3], float out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees)
 {
     const float origin[3] = {0.0f, 0.0f, 0.0f};
@@ -134,7 +116,7 @@ umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], fl
     umbra_camera c;
     memset(&c, 0, sizeof c);
     float d[3] = {dir[0], dir[1], dir[2]};
-    normalize3(d);
+    umbra__normalize3(d);
     if (!(fovy_degrees > 0.0f && fovy_degrees < 180.0f))
         fovy_degrees = 30.0f;
     float dist = 0.5f * box_diagonal / sinf(0.5f * fovy_degrees * 3.14159265f / 180.0f) * 1.05f;
@@ -186,13 +168,6 @@ void umbra_renderer_retain(umbra_renderer r)
         atomic_fetch_add(&r->refs, 1);
 }
 
-static void release_mem(cl_mem *m)
-{
-    if (*m)
-        clReleaseMemObject(*m);
-    *m = NULL;
-}
-
 static void release_kernels(umbra_renderer r)
 {
     if (r->render_kernel)
@@ -222,7 +197,7 @@ void umbra_renderer_release(umbra_renderer r)
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
                       &r->out_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
-        release_mem(mems[i]);
+        umbra__release_mem(mems[i]);
     umbra_volume_release(r->volume);
     umbra_transfer_function_release(r->tf);
     umbra_transfer_function_release(r->light_tf);
@@ -233,10 +208,6 @@ void umbra_renderer_release(umbra_renderer r)
 }
 
 /* ---- setters ------------------------------------------------------------------------------------- */
-
-#define CHECK_R(fn)                                                                            \
-    if (!r)                                                                                    \
-        return UMBRA_ERROR_INVALID_ARGUMENT;
 
 umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume)
 {
@@ -337,7 +308,7 @@ umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_camera *c)
     }
     r->camera = *c;
     /* Only up's direction matters; a unit up keeps the frame's cross products finite. */
-    normalize3(r->camera.up);
+    umbra__normalize3(r->camera.up);
     r->camera_set = 1;
     return UMBRA_SUCCESS;
 }
@@ -357,7 +328,7 @@ umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *l)
                            "(%g, %g, %g) finite", fn, l->position[0], l->position[1],
                            l->position[2], UMBRA_MAX_COORDINATE, l->direction[0],
                            l->direction[1], l->direction[2]);
-    if (l->type == UMBRA_LIGHT_DIRECTIONAL && !(len3d(l->direction) > 0.0))
+    if (l->type == UMBRA_LIGHT_DIRECTIONAL && !(umbra__len3d(l->direction) > 0.0))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: directional light direction (0, 0, 0) has no direction", fn);
     for (int i = 0; i < 3; ++i)
@@ -367,7 +338,7 @@ umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *l)
                                l->color[1], l->color[2]);
     r->light = *l;
     if (l->type == UMBRA_LIGHT_DIRECTIONAL)
-        normalize3(r->light.direction);
+        umbra__normalize3(r->light.direction);
     return UMBRA_SUCCESS;
 }
 
@@ -445,357 +416,6 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
     }
     r->shadow = *d;
     return UMBRA_SUCCESS;
-}
-
-/* ---- tables ---------------------------------------------------------------------------------------- */
-
-float umbra__voxel_world(umbra_renderer r)
-{
-    const float *s = r->volume->spacing;
-    return fminf(s[0], fminf(s[1], s[2]));
-}
-
-/* The integral over table interval i (from entry i to i + 1, in table units) of the extinction
- * -ln(1 - a) (a at most 1 - 2^-24, kernels/common.cl) times 1 - t_c for c = r, g, b and times 1
- * (grey), the entries interpolated linearly: composite three-point Gauss in double over 16
- * pieces, which resolves the log's curvature up to the clamp. */
-static void interval_depths(const float *e, double out[4])
-{
-    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
-    static const double weight[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-    out[0] = out[1] = out[2] = out[3] = 0.0;
-    for (int piece = 0; piece < 16; ++piece)
-        for (int q = 0; q < 3; ++q) {
-            double w = (piece + 0.5 + 0.5 * node[q]) / 16.0, c[4];
-            for (int k = 0; k < 4; ++k)
-                c[k] = e[k] + w * (e[4 + k] - e[k]);
-            double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
-            double sigma = -log1p(-a) * weight[q] / 16.0;
-            for (int k = 0; k < 3; ++k)
-                out[k] += sigma * (1.0 - c[k]);
-            out[3] += sigma;
-        }
-}
-
-/* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
- * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
- * alpha_for_length in kernels/common.cl). step_voxels 0 makes the light table: the alphas as
- * given (kernels convert the interpolated alpha to extinction per sample, kernels/common.cl),
- * followed by 2 count float4: for each entry k, the sum over the intervals before it of
- * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
- * from which the exact reference takes the depth of whole table intervals with two loads and no
- * cancellation (kernels/shadow_reference.cl). */
-static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
-                                    cl_mem *buf)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    const int light = step_voxels == 0.0f;
-    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 3 : 1);
-    float *t = malloc(bytes);
-    if (!t)
-        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
-    for (uint32_t i = 0; i < tf->count; ++i) {
-        memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
-        double a = tf->rgba[4 * i + 3];
-        t[4 * i + 3] = light ? (float)a
-                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
-                                 : 1.0f;
-    }
-    if (light) {
-        double sum[4] = {0, 0, 0, 0}, d[4];
-        float *p = t + 4 * (size_t)tf->count;
-        for (uint32_t k = 0; k < tf->count; ++k) {
-            for (int c = 0; c < 4; ++c) {
-                float hi = (float)sum[c];
-                p[8 * k + c] = hi;
-                p[8 * k + 4 + c] = (float)(sum[c] - (double)hi);
-            }
-            if (k + 1 < tf->count) {
-                interval_depths(tf->rgba + 4 * k, d);
-                for (int c = 0; c < 4; ++c)
-                    sum[c] += d[c];
-            }
-        }
-    }
-    release_mem(buf);
-    cl_int err;
-    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, t, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(corrected transfer function)");
-fail:
-    free(t);
-    return st;
-}
-
-/* Whether some table entry that values in [minmax[0], minmax[1]] interpolate has alpha > 0. */
-static int range_visible(umbra_transfer_function tf, const float minmax[2])
-{
-    const float last = (float)(tf->count - 1);
-    int lo = (int)floorf(minmax[0] * last), hi = (int)ceilf(minmax[1] * last);
-    lo = lo < 0 ? 0 : lo;
-    hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
-    for (int i = lo; i <= hi; ++i)
-        if (tf->rgba[4 * i + 3] > 0.0f)
-            return 1;
-    return 0;
-}
-
-/* Replaces *buf by a read-only device copy of host (bytes long, freed here; NULL: out of
- * memory). what names the table in an error. */
-static umbra_status upload_table(umbra_renderer r, void *host, size_t bytes, const char *what,
-                                 cl_mem *buf)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    if (!host)
-        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                           "umbra_renderer_render: out of memory for the %s", what);
-    release_mem(buf);
-    cl_int err;
-    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, host,
-                          &err);
-    UMBRA_CL_CHECK(err, what);
-fail:
-    free(host);
-    return st;
-}
-
-/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
-static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
-{
-    umbra_volume v = r->volume;
-    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
-    unsigned char *flags = malloc(n);
-    for (size_t b = 0; flags && b < n; ++b)
-        flags[b] = (unsigned char)range_visible(tf, v->brick_minmax + 2 * b);
-    return upload_table(r, flags, n, "brick table", buf);
-}
-
-/* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
- * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS). */
-static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
-{
-    umbra_volume v = r->volume;
-    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
-    const uint32_t cells = UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS;
-    uint64_t *masks = calloc(n, sizeof *masks);
-    for (size_t b = 0; masks && b < n; ++b)
-        for (uint32_t c = 0; c < cells; ++c)
-            if (range_visible(tf, v->cell_minmax + 2 * (b * cells + c)))
-                masks[b] |= (uint64_t)1 << c;
-    return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
-}
-
-/* The step-corrected table of tf, its cell masks and, with brick_buf, its brick table, kept while
- * tf, the volume and the step stay the same. */
-static umbra_status tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
-                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf, cl_mem *cell_buf)
-{
-    uint32_t bits;
-    memcpy(&bits, &step_voxels, sizeof bits);
-    uint64_t want[3] = {tf->id, r->volume->id, bits};
-    if (*tf_buf && *cell_buf && (!brick_buf || *brick_buf) && memcmp(want, key, sizeof want) == 0)
-        return UMBRA_SUCCESS;
-    umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
-    if (st == UMBRA_SUCCESS && brick_buf)
-        st = brick_table(r, tf, brick_buf);
-    if (st == UMBRA_SUCCESS)
-        st = cell_table(r, tf, cell_buf);
-    if (st == UMBRA_SUCCESS)
-        memcpy(key, want, sizeof want);
-    else
-        memset(key, 0, 3 * sizeof key[0]);
-    return st;
-}
-
-umbra_status umbra__light_tables(umbra_renderer r)
-{
-    return tables(r, umbra__light_tf(r), 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
-                  &r->light_cells_buf);
-}
-
-/* ---- per-frame constants ------------------------------------------------------------------------------ */
-
-static void set4(float dst[4], float x, float y, float z, float w)
-{
-    dst[0] = x;
-    dst[1] = y;
-    dst[2] = z;
-    dst[3] = w;
-}
-
-void umbra__frame_update_light(umbra_renderer r)
-{
-    UmbraFrame *F = &r->frame;
-    umbra_volume v = r->volume;
-    float ext[3];
-    for (int a = 0; a < 3; ++a)
-        ext[a] = (float)v->dims[a] * v->spacing[a];
-    set4(F->box_min, -0.5f * ext[0], -0.5f * ext[1], -0.5f * ext[2], 0.0f);
-    set4(F->box_max, 0.5f * ext[0], 0.5f * ext[1], 0.5f * ext[2], 0.0f);
-    set4(F->inv_spacing, 1.0f / v->spacing[0], 1.0f / v->spacing[1], 1.0f / v->spacing[2], 0.0f);
-    for (int a = 0; a < 3; ++a) {
-        F->dims[a] = (int32_t)v->dims[a];
-        F->bricks[a] = (int32_t)v->brick_counts[a];
-    }
-    F->dims[3] = 0;
-    F->bricks[3] = (int32_t)v->brick_size;
-    /* The light is given in the volume's world; the kernels work in its local frame. */
-    const umbra_light *l = &r->light;
-    float lp[3];
-    if (l->type == UMBRA_LIGHT_POINT) {
-        umbra__volume_point_to_local(v, l->position, lp);
-        set4(F->light, lp[0], lp[1], lp[2], 1.0f);
-    } else {
-        umbra__volume_dir_to_local(v, l->direction, lp);
-        set4(F->light, lp[0], lp[1], lp[2], 0.0f);
-    }
-    set4(F->light_color, l->color[0], l->color[1], l->color[2], 0.0f);
-    F->flags &= ~(UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
-    if (l->type == UMBRA_LIGHT_POINT)
-        F->flags |= UMBRA_FLAG_POINT_LIGHT;
-    if (r->opts.transmission == UMBRA_TRANSMISSION_COLORED)
-        F->flags |= UMBRA_FLAG_COLORED;
-    if (r->opts.empty_space_skipping)
-        F->flags |= UMBRA_FLAG_SKIP_EMPTY;
-    F->step_ref = umbra__voxel_world(r);
-    F->light_tf_size = umbra__light_tf(r)->count;
-    r->channels = (r->opts.transmission == UMBRA_TRANSMISSION_GREY ||
-                   umbra_transfer_function_is_grey(umbra__light_tf(r)))
-                      ? 1u
-                      : 3u;
-    r->shadow_params.channels = r->channels;
-}
-
-static void frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
-{
-    UmbraFrame *F = &r->frame;
-    const umbra_render_desc *o = &r->opts;
-    float ext[3], diag = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        ext[a] = (float)r->volume->dims[a] * r->volume->spacing[a];
-        diag += ext[a] * ext[a];
-    }
-    diag = sqrtf(diag);
-    umbra_volume v = r->volume;
-    umbra_camera c = r->camera;
-    if (!r->camera_set) {
-        const float dir[3] = {0.6f, 0.45f, 1.0f}, zero[3] = {0.0f, 0.0f, 0.0f};
-        double centre[3];
-        umbra__volume_point_to_world(v, zero, centre);
-        const float at[3] = {(float)centre[0], (float)centre[1], (float)centre[2]};
-        c = umbra_camera_orbit_at(at, dir, diag, 30.0f);
-    }
-    /* The camera's frame is built in the world (so a mirrored volume does not mirror the
-     * image) and then taken into the volume's local frame, vector by vector. */
-    float fw[3] = {c.target[0] - c.eye[0], c.target[1] - c.eye[1], c.target[2] - c.eye[2]};
-    normalize3(fw);
-    float rw[3], uw[3], f[3], right[3], up[3], eye[3];
-    cross3(fw, c.up, rw);
-    normalize3(rw);
-    cross3(rw, fw, uw);
-    umbra__volume_dir_to_local(v, fw, f);
-    umbra__volume_dir_to_local(v, rw, right);
-    umbra__volume_dir_to_local(v, uw, up);
-    umbra__volume_point_to_local(v, c.eye, eye);
-    float aspect = (float)width / (float)height;
-    float half_h = c.projection == UMBRA_ORTHOGRAPHIC
-                       ? 0.5f * c.ortho_height
-                       : tanf(0.5f * c.fovy_degrees * 3.14159265358979f / 180.0f);
-    float half_w = half_h * aspect;
-    set4(F->eye, eye[0], eye[1], eye[2], 0.0f);
-    set4(F->right, right[0] * half_w, right[1] * half_w, right[2] * half_w, 0.0f);
-    set4(F->up, up[0] * half_h, up[1] * half_h, up[2] * half_h, 0.0f);
-    set4(F->forward, f[0], f[1], f[2], 0.0f);
-    set4(F->ambient, o->ambient[0], o->ambient[1], o->ambient[2], 0.0f);
-    set4(F->background, o->background[0], o->background[1], o->background[2], o->background[3]);
-    set4(F->ground_color, o->ground_color[0], o->ground_color[1], o->ground_color[2], 0.0f);
-    umbra__ground_plane(v, ext, o->ground_offset * diag, F->ground);
-    F->width = width;
-    F->height = height;
-    F->seed = o->seed;
-    F->step = o->step * umbra__voxel_world(r);
-    F->termination = o->termination;
-    F->kd = o->kd;
-    F->ks = o->ks;
-    F->shininess = o->shininess;
-    F->tf_size = umbra__view_tf(r)->count;
-    uint32_t keep = F->flags & (UMBRA_FLAG_POINT_LIGHT | UMBRA_FLAG_COLORED | UMBRA_FLAG_SKIP_EMPTY);
-    F->flags = keep | (o->jitter ? UMBRA_FLAG_JITTER : 0u) | (o->shading ? UMBRA_FLAG_SHADING : 0u) |
-               (o->ground_plane ? UMBRA_FLAG_GROUND : 0u) |
-               (c.projection == UMBRA_ORTHOGRAPHIC ? UMBRA_FLAG_ORTHO : 0u);
-}
-
-static umbra_status ensure_buffer(umbra_renderer r, cl_mem *buf, size_t bytes, cl_mem_flags flags)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    if (*buf)
-        return UMBRA_SUCCESS;
-    cl_int err;
-    *buf = clCreateBuffer(ctx->cl_ctx, flags, bytes, NULL, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer");
-fail:
-    return st;
-}
-
-umbra_status umbra__upload_params(umbra_renderer r)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    cl_int err;
-    /* New buffers rather than writes into the old ones: a write from r->frame would have to wait
-     * (or r->frame stay unchanged) until it ran, and a frame still queued behind the application's
-     * wait list must keep its own constants. OpenCL frees the old buffers once the commands that
-     * use them have completed. */
-    release_mem(&r->frame_buf);
-    release_mem(&r->shadow_buf);
-    r->frame_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                  sizeof r->frame, &r->frame, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(frame constants)");
-    r->shadow_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                   sizeof r->shadow_params, &r->shadow_params, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(shadow constants)");
-fail:
-    return st;
-}
-
-umbra_status umbra__frame_gate(umbra_renderer r)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    if (!r->async || r->async->gated)
-        return UMBRA_SUCCESS;
-    if (r->async->num_wait)
-        UMBRA_CL(clEnqueueBarrierWithWaitList(ctx->queue, r->async->num_wait, r->async->wait_list,
-                                              NULL));
-    r->async->gated = 1;
-fail:
-    return st;
-}
-
-void umbra__build_options(umbra_renderer r, char *buf, size_t size)
-{
-    snprintf(buf, size, "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u",
-             r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels);
-}
-
-umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    cl_mem vol = r->volume->image ? r->volume->image : r->volume->data;
-    cl_mem view_tf = r->view_tf_buf ? r->view_tf_buf : r->light_tf_buf;
-    /* A shadow build runs before the view tables exist and does not read them: any buffer will
-     * do for the argument. */
-    cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_cells_buf;
-    cl_mem args[] = {r->frame_buf, vol, view_tf, r->light_tf_buf, view_bricks,
-                     r->light_cells_buf, r->shadow_buf};
-    for (cl_uint i = 0; i < sizeof args / sizeof args[0]; ++i)
-        UMBRA_CL(clSetKernelArg(k, i, sizeof(cl_mem), &args[i]));
-    *next = (cl_uint)(sizeof args / sizeof args[0]);
-fail:
-    return st;
 }
 
 /* ---- the frame ---------------------------------------------------------------------------------------- */
@@ -908,7 +528,7 @@ static umbra_timing measured_timing(umbra_renderer r)
 
 /* Renders the frame into out. Blocking frames wait for it; asynchronous ones (r->async) only
  * enqueue it, gated on their wait list. */
-static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out)
+umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out)
 {
     const char *fn = "umbra_renderer_render";
     umbra_context ctx = r->ctx;
@@ -927,11 +547,11 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
-    st = tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
+    st = umbra__tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
                 &r->view_bricks_buf, &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
-    frame_update_view(r, width, height);
+    umbra__frame_update_view(r, width, height);
     r->stats.slices = 0;
     r->stats.render_timing = r->async ? UMBRA_TIMING_NONE : measured_timing(r);
     if (r->tech->render) {
@@ -943,7 +563,7 @@ static umbra_status render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     }
     st = ensure_kernels(r);
     if (st == UMBRA_SUCCESS)
-        st = ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
+        st = umbra__ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
     if (st == UMBRA_SUCCESS)
         st = umbra__upload_params(r);
     if (st != UMBRA_SUCCESS)
@@ -1001,7 +621,7 @@ fail:
     return st;
 }
 
-static umbra_status check_size(umbra_renderer r, uint32_t width, uint32_t height, const char *fn)
+umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height, const char *fn)
 {
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -1016,152 +636,22 @@ umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t he
     umbra_context ctx = r->ctx;
     if (!rgba)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
-    umbra_status st = check_size(r, width, height, fn);
+    umbra_status st = umbra__check_size(r, width, height, fn);
     if (st != UMBRA_SUCCESS)
         return st;
     size_t bytes = (size_t)width * height * 4 * sizeof(float);
     if (r->out_bytes != bytes)
-        release_mem(&r->out_buf);
-    st = ensure_buffer(r, &r->out_buf, bytes, CL_MEM_WRITE_ONLY);
+        umbra__release_mem(&r->out_buf);
+    st = umbra__ensure_buffer(r, &r->out_buf, bytes, CL_MEM_WRITE_ONLY);
     if (st != UMBRA_SUCCESS)
         return st;
     r->out_bytes = bytes;
-    st = render_into(r, width, height, r->out_buf);
+    st = umbra__render_into(r, width, height, r->out_buf);
     if (st != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->out_buf, CL_TRUE, 0, bytes, rgba, 0, NULL, NULL));
     umbra__progress_end(r);
 fail:
-    return st;
-}
-
-static const char *mem_type_name(cl_mem_object_type t)
-{
-    switch (t) {
-    case CL_MEM_OBJECT_BUFFER: return "buffer";
-    case CL_MEM_OBJECT_IMAGE2D: return "2D image";
-    case CL_MEM_OBJECT_IMAGE3D: return "3D image";
-    case CL_MEM_OBJECT_IMAGE2D_ARRAY: return "2D image array";
-    case CL_MEM_OBJECT_IMAGE1D: return "1D image";
-    case CL_MEM_OBJECT_IMAGE1D_ARRAY: return "1D image array";
-    case CL_MEM_OBJECT_IMAGE1D_BUFFER: return "1D image buffer";
-    default: return "memory object of unknown type";
-    }
-}
-
-/* The application's output buffer (context.h contract point 2): a buffer of this cl_context that
- * kernels may write, of at least 16*w*h bytes. */
-static umbra_status check_app_buffer(umbra_renderer r, cl_mem rgba, uint32_t width,
-                                     uint32_t height, const char *fn)
-{
-    umbra_context ctx = r->ctx;
-    if (!rgba)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
-    size_t have = 0;
-    cl_context owner = NULL;
-    cl_mem_object_type type = 0;
-    cl_mem_flags flags = 0;
-    cl_int err = clGetMemObjectInfo(rgba, CL_MEM_TYPE, sizeof type, &type, NULL);
-    if (err == CL_SUCCESS)
-        err = clGetMemObjectInfo(rgba, CL_MEM_CONTEXT, sizeof owner, &owner, NULL);
-    if (err == CL_SUCCESS)
-        err = clGetMemObjectInfo(rgba, CL_MEM_SIZE, sizeof have, &have, NULL);
-    if (err == CL_SUCCESS)
-        err = clGetMemObjectInfo(rgba, CL_MEM_FLAGS, sizeof flags, &flags, NULL);
-    if (err != CL_SUCCESS)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: rgba %p is not a valid cl_mem (clGetMemObjectInfo: %s, %d)", fn,
-                           (void *)rgba, umbra__cl_error_name(err), (int)err);
-    if (owner != ctx->cl_ctx)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: rgba %p belongs to another cl_context (%p; the renderer's is %p)",
-                           fn, (void *)rgba, (void *)owner, (void *)ctx->cl_ctx);
-    if (type != CL_MEM_OBJECT_BUFFER)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: rgba %p is a %s (CL_MEM_TYPE 0x%x); a buffer is required", fn,
-                           (void *)rgba, mem_type_name(type), (unsigned)type);
-    if (flags & CL_MEM_READ_ONLY)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: rgba %p was created CL_MEM_READ_ONLY; kernels must write it", fn,
-                           (void *)rgba);
-    if (have < (size_t)width * height * 16)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: rgba %p holds %zu bytes; %u x %u RGBA floats need %zu", fn,
-                           (void *)rgba, have, width, height, (size_t)width * height * 16);
-    return UMBRA_SUCCESS;
-}
-
-umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
-                                                cl_mem rgba)
-{
-    const char *fn = "umbra_renderer_render_to_cl_buffer";
-    CHECK_R();
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS ||
-        (st = check_app_buffer(r, rgba, width, height, fn)) != UMBRA_SUCCESS)
-        return st;
-    clRetainMemObject(rgba);
-    st = render_into(r, width, height, rgba);
-    if (st == UMBRA_SUCCESS)
-        UMBRA_CL(clFinish(ctx->queue));
-fail:
-    clReleaseMemObject(rgba);
-    if (st == UMBRA_SUCCESS)
-        umbra__progress_end(r);
-    return st;
-}
-
-umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
-                                                      uint32_t height, cl_mem rgba,
-                                                      cl_uint num_wait, const cl_event *wait_list,
-                                                      cl_event *done)
-{
-    const char *fn = "umbra_renderer_render_to_cl_buffer_async";
-    CHECK_R();
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    if (!done)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: done is NULL", fn);
-    *done = NULL;
-    if ((st = check_size(r, width, height, fn)) != UMBRA_SUCCESS ||
-        (st = check_app_buffer(r, rgba, width, height, fn)) != UMBRA_SUCCESS)
-        return st;
-    if ((num_wait > 0) != (wait_list != NULL))
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: num_wait %u with wait_list %p: a list needs a count and a count "
-                           "a list", fn, num_wait, (const void *)wait_list);
-    for (cl_uint i = 0; i < num_wait; ++i) {
-        cl_context owner = NULL;
-        if (!wait_list[i] || clGetEventInfo(wait_list[i], CL_EVENT_CONTEXT, sizeof owner, &owner,
-                                            NULL) != CL_SUCCESS)
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: wait_list[%u] %p is not a valid event", fn, i,
-                               (void *)wait_list[i]);
-        if (owner != ctx->cl_ctx)
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: wait_list[%u] %p belongs to another cl_context (%p; the "
-                               "renderer's is %p)", fn, i, (void *)wait_list[i], (void *)owner,
-                               (void *)ctx->cl_ctx);
-    }
-    umbra__async async = {num_wait, wait_list, 0};
-    r->async = &async;
-    st = render_into(r, width, height, rgba);
-    r->async = NULL;
-    if (st != UMBRA_SUCCESS)
-        return st;
-    if (!async.gated)
-        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                           "%s: technique '%s' enqueued its frame without the wait list's barrier",
-                           fn, umbra_shadow_technique_name(r->tech->id));
-    /* On the in-order queue, a marker completes once every command before it has. */
-    UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, done));
-    UMBRA_CL(clFlush(ctx->queue));
-    return UMBRA_SUCCESS;
-fail:
-    if (*done)
-        clReleaseEvent(*done);
-    *done = NULL;
     return st;
 }
 
@@ -1223,8 +713,8 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     umbra__progress_end(r);
 fail:
     free(moved);
-    release_mem(&in);
-    release_mem(&outb);
+    umbra__release_mem(&in);
+    umbra__release_mem(&outb);
     return st;
 }
 

@@ -7,6 +7,8 @@
 #ifndef UMBRA_RENDERER_INTERNAL_H
 #define UMBRA_RENDERER_INTERNAL_H
 
+#include <math.h>
+
 #include "internal.h"
 #include "umbra_shared.h"
 
@@ -159,6 +161,63 @@ void umbra__frame_update_light(umbra_renderer r);
  * sample, kernels/common.cl) and r->light_cells_buf the visibility of each brick's sub-cells
  * under it. */
 umbra_status umbra__light_tables(umbra_renderer r);
+
+/* ---- shared between host/renderer.c, tables.c, frame.c and render_cl.c ---------------------- */
+
+/* Every public renderer call starts with this: a NULL renderer has no context to record on. */
+#define CHECK_R(fn)                                                                            \
+    if (!r)                                                                                    \
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+
+/* Small vector helpers (lengths in double, so 1e20 does not overflow a float square). */
+static inline double umbra__len3d(const float v[3])
+{
+    return sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+}
+
+static inline void umbra__normalize3(float v[3])
+{
+    double l = umbra__len3d(v);
+    if (l > 0.0)
+        for (int i = 0; i < 3; ++i)
+            v[i] = (float)(v[i] / l);
+}
+
+static inline void umbra__cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Releases *m if set and clears it. */
+static inline void umbra__release_mem(cl_mem *m)
+{
+    if (*m)
+        clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+/* tf's table for step_voxels (0: the light's, uncorrected) into *tf_buf, and, where the buffers
+ * are given, the bricks and sub-cells it makes visible; rebuilt only when key (tf id, volume id,
+ * step) changes (host/tables.c). */
+umbra_status umbra__tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
+                           uint64_t key[3], cl_mem *tf_buf, cl_mem *bricks_buf,
+                           cl_mem *cells_buf);
+
+/* The view part of the frame constants for a width x height image (host/frame.c). */
+void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height);
+
+/* Makes *buf a buffer of at least bytes (reallocated when smaller). */
+umbra_status umbra__ensure_buffer(umbra_renderer r, cl_mem *buf, size_t bytes,
+                                  cl_mem_flags flags);
+
+/* Renders the frame into out (host/renderer.c): blocking frames wait for it; asynchronous ones
+ * (r->async) only enqueue it, gated on their wait list. */
+umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out);
+
+/* Refuses a zero or oversized image, naming fn. */
+umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height, const char *fn);
 
 /* Marks the point in a frame after which commands must wait for an asynchronous frame's wait
  * list (a no-op for blocking frames): the renderer or technique calls it once, after everything

@@ -1,0 +1,176 @@
+/* host/tables.c: the renderer's per-(transfer function, volume, step) tables: step-corrected
+ * transfer-function tables (the light's uncorrected, with per-interval depth integrals), and
+ * which bricks and sub-cells of the volume those make visible, uploaded once per key and reused
+ * until the key changes (host/renderer.c calls umbra__tables before every frame). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "preintegration.h"
+#include "renderer_internal.h"
+
+float umbra__voxel_world(umbra_renderer r)
+{
+    const float *s = r->volume->spacing;
+    return fminf(s[0], fminf(s[1], s[2]));
+}
+
+/* The integral over table interval i (from entry i to i + 1, in table units) of the extinction
+ * -ln(1 - a) (a at most 1 - 2^-24, kernels/common.cl) times 1 - t_c for c = r, g, b and times 1
+ * (grey), the entries interpolated linearly: composite three-point Gauss in double over 16
+ * pieces, which resolves the log's curvature up to the clamp. */
+static void interval_depths(const float *e, double out[4])
+{
+    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+    static const double weight[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+    out[0] = out[1] = out[2] = out[3] = 0.0;
+    for (int piece = 0; piece < 16; ++piece)
+        for (int q = 0; q < 3; ++q) {
+            double w = (piece + 0.5 + 0.5 * node[q]) / 16.0, c[4];
+            for (int k = 0; k < 4; ++k)
+                c[k] = e[k] + w * (e[4 + k] - e[k]);
+            double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
+            double sigma = -log1p(-a) * weight[q] / 16.0;
+            for (int k = 0; k < 3; ++k)
+                out[k] += sigma * (1.0 - c[k]);
+            out[3] += sigma;
+        }
+}
+
+/* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
+ * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
+ * alpha_for_length in kernels/common.cl). step_voxels 0 makes the light table: the alphas as
+ * given (kernels convert the interpolated alpha to extinction per sample, kernels/common.cl),
+ * followed by 2 count float4: for each entry k, the sum over the intervals before it of
+ * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
+ * from which the exact reference takes the depth of whole table intervals with two loads and no
+ * cancellation (kernels/shadow_reference.cl). */
+static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
+                                    cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const int light = step_voxels == 0.0f;
+    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 3 : 1);
+    float *t = malloc(bytes);
+    if (!t)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
+    for (uint32_t i = 0; i < tf->count; ++i) {
+        memcpy(t + 4 * i, tf->rgba + 4 * i, 3 * sizeof(float));
+        double a = tf->rgba[4 * i + 3];
+        t[4 * i + 3] = light ? (float)a
+                       : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                 : 1.0f;
+    }
+    if (light) {
+        double sum[4] = {0, 0, 0, 0}, d[4];
+        float *p = t + 4 * (size_t)tf->count;
+        for (uint32_t k = 0; k < tf->count; ++k) {
+            for (int c = 0; c < 4; ++c) {
+                float hi = (float)sum[c];
+                p[8 * k + c] = hi;
+                p[8 * k + 4 + c] = (float)(sum[c] - (double)hi);
+            }
+            if (k + 1 < tf->count) {
+                interval_depths(tf->rgba + 4 * k, d);
+                for (int c = 0; c < 4; ++c)
+                    sum[c] += d[c];
+            }
+        }
+    }
+    umbra__release_mem(buf);
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, t, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(corrected transfer function)");
+fail:
+    free(t);
+    return st;
+}
+
+/* Whether some table entry that values in [minmax[0], minmax[1]] interpolate has alpha > 0. */
+static int range_visible(umbra_transfer_function tf, const float minmax[2])
+{
+    const float last = (float)(tf->count - 1);
+    int lo = (int)floorf(minmax[0] * last), hi = (int)ceilf(minmax[1] * last);
+    lo = lo < 0 ? 0 : lo;
+    hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
+    for (int i = lo; i <= hi; ++i)
+        if (tf->rgba[4 * i + 3] > 0.0f)
+            return 1;
+    return 0;
+}
+
+/* Replaces *buf by a read-only device copy of host (bytes long, freed here; NULL: out of
+ * memory). what names the table in an error. */
+static umbra_status upload_table(umbra_renderer r, void *host, size_t bytes, const char *what,
+                                 cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (!host)
+        return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                           "umbra_renderer_render: out of memory for the %s", what);
+    umbra__release_mem(buf);
+    cl_int err;
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, host,
+                          &err);
+    UMBRA_CL_CHECK(err, what);
+fail:
+    free(host);
+    return st;
+}
+
+/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
+static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+{
+    umbra_volume v = r->volume;
+    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    unsigned char *flags = malloc(n);
+    for (size_t b = 0; flags && b < n; ++b)
+        flags[b] = (unsigned char)range_visible(tf, v->brick_minmax + 2 * b);
+    return upload_table(r, flags, n, "brick table", buf);
+}
+
+/* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
+ * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS). */
+static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+{
+    umbra_volume v = r->volume;
+    const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
+    const uint32_t cells = UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS;
+    uint64_t *masks = calloc(n, sizeof *masks);
+    for (size_t b = 0; masks && b < n; ++b)
+        for (uint32_t c = 0; c < cells; ++c)
+            if (range_visible(tf, v->cell_minmax + 2 * (b * cells + c)))
+                masks[b] |= (uint64_t)1 << c;
+    return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
+}
+
+/* The step-corrected table of tf, its cell masks and, with brick_buf, its brick table, kept while
+ * tf, the volume and the step stay the same. */
+umbra_status umbra__tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
+                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf, cl_mem *cell_buf)
+{
+    uint32_t bits;
+    memcpy(&bits, &step_voxels, sizeof bits);
+    uint64_t want[3] = {tf->id, r->volume->id, bits};
+    if (*tf_buf && *cell_buf && (!brick_buf || *brick_buf) && memcmp(want, key, sizeof want) == 0)
+        return UMBRA_SUCCESS;
+    umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
+    if (st == UMBRA_SUCCESS && brick_buf)
+        st = brick_table(r, tf, brick_buf);
+    if (st == UMBRA_SUCCESS)
+        st = cell_table(r, tf, cell_buf);
+    if (st == UMBRA_SUCCESS)
+        memcpy(key, want, sizeof want);
+    else
+        memset(key, 0, 3 * sizeof key[0]);
+    return st;
+}
+
+umbra_status umbra__light_tables(umbra_renderer r)
+{
+    return umbra__tables(r, umbra__light_tf(r), 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
+                  &r->light_cells_buf);
+}
