@@ -12,7 +12,9 @@
  *  - the process-wide state umbra touches (POCL_CACHE_DIR, UMBRA_DEVICE) can be left alone, and a
  *    context description of the previous, shorter layout is still accepted.
  *
- * Usage: test_context [filter] (a cmocka test-name glob). */
+ * Usage: test_context [filter] (a cmocka test-name glob).
+ *
+ * Why one file past 800 lines: one test per contract point, each independent; a table of cases. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stddef.h>
