@@ -119,7 +119,8 @@ UMBRA_API umbra_status umbra_context_create(const umbra_context_desc *desc, umbr
  * device. Touches no process-wide state. */
 UMBRA_API umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device,
                                                     cl_command_queue queue,
-                                                    const umbra_context_desc *desc, umbra_context *out);
+                                                    const umbra_context_desc *desc,
+                                                    umbra_context *out);
 
 /* Adds one reference (for an application that keeps the context beyond its objects). NULL is a
  * no-op. */
@@ -144,7 +145,8 @@ UMBRA_API umbra_status umbra_context_record_error(umbra_context ctx, umbra_statu
                                                   const char *message);
 
 /* Installs (or with NULL removes) the error callback. */
-UMBRA_API void umbra_context_set_error_callback(umbra_context ctx, umbra_error_callback cb, void *user);
+UMBRA_API void umbra_context_set_error_callback(umbra_context ctx, umbra_error_callback cb,
+                                                void *user);
 
 /* "platform / device" names, owned by the context. */
 UMBRA_API const char *umbra_context_device_name(umbra_context ctx);

@@ -17,7 +17,8 @@ typedef enum umbra_status {
     UMBRA_ERROR_INVALID_ARGUMENT = 1, /* a NULL pointer, a zero size, a NaN, a value out of range */
     UMBRA_ERROR_OUT_OF_MEMORY = 2,    /* host or device allocation failed */
     UMBRA_ERROR_OPENCL = 3,           /* an OpenCL call failed; the message names call and cl_int */
-    UMBRA_ERROR_BUILD = 4,            /* a kernel program failed to build; the message has the log */
+    UMBRA_ERROR_BUILD = 4,            /* a kernel program failed to build; the message has the
+                                         log */
     UMBRA_ERROR_IO = 5,               /* a file could not be opened, read or written */
     UMBRA_ERROR_FORMAT = 6,           /* a file was read but its contents are malformed */
     UMBRA_ERROR_UNSUPPORTED = 7,      /* valid request this device or technique cannot do */

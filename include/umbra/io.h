@@ -34,13 +34,15 @@ UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, um
  * waited on); the declared sizes are checked against the data before anything is allocated: raw
  * data must fill the rest of its file exactly, gzip can expand at most 1032:1 and zrl 16384:1
  * (else UMBRA_ERROR_FORMAT naming both sizes). */
-UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out);
+UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path,
+                                              umbra_volume *out);
 
 /* Loads a Voreen .dat header and its raw file (both regular files), which is looked up relative
- * to the .dat's directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT)
- * are required; ObjectModel, if present, must be I. SliceThickness is the spacing; the format
- * has no origin, so the box is centred. */
-UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out);
+ * to the .dat's directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT,
+ * SHORT, FLOAT) are required; ObjectModel, if present, must be I. SliceThickness is the
+ * spacing; the format has no origin, so the box is centred. */
+UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path,
+                                             umbra_volume *out);
 
 /* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz) through
  * nifticlib. 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and
@@ -49,7 +51,10 @@ UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path
  * other than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's
  * real values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform
  * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
- * the file's units. MetaImage and VTK .vti are not supported (no small maintained library). The header's sizes are checked against the file before the voxels are read. */
+ * the file's units; the sform (else the qform) also places the volume in the file's world (its
+ * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). The header's sizes are
+ * checked against the file before the voxels are read. MetaImage and VTK .vti are not supported
+ * (no small maintained library). */
 UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
                                                umbra_volume *out);
 
@@ -65,10 +70,11 @@ typedef struct umbra_raw_desc {
 /* Fills desc with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_raw_desc_init(umbra_raw_desc *desc);
 
-/* Loads a headerless raw file (a regular file, else UMBRA_ERROR_IO). The file must hold exactly header_bytes + dims product * type size
- * bytes; any other size is UMBRA_ERROR_FORMAT naming both numbers. */
-UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
-                                             umbra_volume *out);
+/* Loads a headerless raw file (a regular file, else UMBRA_ERROR_IO). The file must hold exactly
+ * header_bytes + dims product * type size bytes; any other size is UMBRA_ERROR_FORMAT naming both
+ * numbers. */
+UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path,
+                                             const umbra_raw_desc *desc, umbra_volume *out);
 
 /* ---- transfer functions ---------------------------------------------------------------------- */
 
@@ -84,8 +90,10 @@ UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const cha
 
 /* Options for ParaView presets; umbra_paraview_options_init sets the defaults. */
 typedef struct umbra_paraview_options {
-    size_t struct_size;      /* sizeof(umbra_paraview_options); set by umbra_paraview_options_init */
-    const char *preset;      /* the "Name" to pick in a file of several; NULL (default): the first */
+    size_t struct_size;      /* sizeof(umbra_paraview_options); set by
+                                umbra_paraview_options_init */
+    const char *preset;      /* the "Name" to pick in a file of several; NULL (default): the
+                                first */
     uint32_t resolution;     /* table entries, 2..65536 (default 1024) */
     int range_given;         /* 0 (default): the table spans the preset's own x range */
     double range_min, range_max; /* with range_given: the data values the table spans */

@@ -60,10 +60,11 @@ typedef struct umbra_camera {
 
 /* A camera looking at the world origin (the centred box's centre) from direction dir (need not
  * be normalised) at a distance that frames a box of the given diagonal; up is +y. */
-UMBRA_API umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees);
+UMBRA_API umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal,
+                                          float fovy_degrees);
 /* The same around center (world units), e.g. umbra_volume_info.center of a transformed volume. */
-UMBRA_API umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], float box_diagonal,
-                                             float fovy_degrees);
+UMBRA_API umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3],
+                                             float box_diagonal, float fovy_degrees);
 
 typedef enum umbra_light_type {
     UMBRA_LIGHT_POINT = 0,
@@ -113,6 +114,7 @@ typedef struct umbra_render_desc {
     umbra_transmission transmission; /* default UMBRA_TRANSMISSION_GREY */
 } umbra_render_desc;
 
+/* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_render_desc_init(umbra_render_desc *desc);
 
 typedef enum umbra_shadow_technique {
@@ -183,6 +185,7 @@ typedef struct umbra_shadow_desc {
                                     light over per slice, [0, 60] (default 5; 0: no blur) */
 } umbra_shadow_desc;
 
+/* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_shadow_desc_init(umbra_shadow_desc *desc);
 
 /* Creates a renderer on ctx (retained). */
@@ -193,7 +196,8 @@ UMBRA_API void umbra_renderer_release(umbra_renderer r); /* NULL is a no-op */
 /* The volume and transfer functions are retained. The light transfer function drives the light
  * pass (and the transmission colour); NULL (the default) uses the view transfer function. */
 UMBRA_API umbra_status umbra_renderer_set_volume(umbra_renderer r, umbra_volume volume);
-UMBRA_API umbra_status umbra_renderer_set_transfer_function(umbra_renderer r, umbra_transfer_function tf);
+UMBRA_API umbra_status umbra_renderer_set_transfer_function(umbra_renderer r,
+                                                            umbra_transfer_function tf);
 UMBRA_API umbra_status umbra_renderer_set_light_transfer_function(umbra_renderer r,
                                                                   umbra_transfer_function tf);
 /* Camera, light, options and shadow descriptions are copied and validated. */
@@ -210,8 +214,8 @@ UMBRA_API umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, u
 /* Renders into the application's buffer (retained during the call; a writable buffer of the
  * context's cl_context of at least 16*w*h bytes, same layout as above; anything else is refused,
  * context.h contract point 2). Blocks until done. */
-UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
-                                                          cl_mem rgba);
+UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width,
+                                                          uint32_t height, cl_mem rgba);
 
 /* As umbra_renderer_render_to_cl_buffer, for applications that pipeline: the frame's commands
  * wait for the num_wait events of wait_list (events of the context's cl_context, e.g. the
@@ -233,13 +237,14 @@ UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint
  * the device time is available from *done when the queue has profiling. */
 UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
                                                                 uint32_t height, cl_mem rgba,
-                                                                cl_uint num_wait, const cl_event *wait_list,
+                                                                cl_uint num_wait,
+                                                                const cl_event *wait_list,
                                                                 cl_event *done);
 
 /* Evaluates the current technique's shadow factor at count points in the volume's world (3 floats
  * each, borrowed) into rgb (3 floats each). Builds the shadow structure first if needed. */
-UMBRA_API umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
-                                                   float *rgb);
+UMBRA_API umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points,
+                                                   size_t count, float *rgb);
 
 /* Where a time in umbra_render_stats comes from (context.h contract point 4). */
 typedef enum umbra_timing {
@@ -264,6 +269,7 @@ typedef struct umbra_render_stats {
     umbra_timing render_timing;  /* what render_ms measures */
 } umbra_render_stats;
 
+/* Copies the last render's figures into *out. UMBRA_ERROR_INVALID_ARGUMENT for NULL r or out. */
 UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
 
 /* Progress and cancellation of long calls. Called on the calling thread during
@@ -278,7 +284,8 @@ typedef int (*umbra_progress_callback)(void *user, float fraction);
 
 /* Installs (or with NULL removes) the progress callback; user is passed to it (borrowed). With a
  * callback, long launches are split into bands, which changes no pixel. */
-UMBRA_API umbra_status umbra_renderer_set_progress(umbra_renderer r, umbra_progress_callback cb, void *user);
+UMBRA_API umbra_status umbra_renderer_set_progress(umbra_renderer r, umbra_progress_callback cb,
+                                                   void *user);
 
 #ifdef __cplusplus
 }

@@ -27,8 +27,8 @@ extern "C" {
 typedef struct umbra_transfer_function_t *umbra_transfer_function;
 
 /* Copies count RGBA entries (4*count floats, each finite and in [0,1]), count >= 2. */
-UMBRA_API umbra_status umbra_transfer_function_create(umbra_context ctx, const float *rgba, uint32_t count,
-                                                      umbra_transfer_function *out);
+UMBRA_API umbra_status umbra_transfer_function_create(umbra_context ctx, const float *rgba,
+                                                      uint32_t count, umbra_transfer_function *out);
 
 /* A control point: value in [0,1] of the normalised range, colour and opacity in [0,1]. */
 typedef struct umbra_tf_point {
@@ -44,13 +44,15 @@ typedef struct umbra_tf_point {
  * Values outside the first and last point take those points' colours. Copies points. */
 UMBRA_API umbra_status umbra_transfer_function_create_from_points(umbra_context ctx,
                                                                   const umbra_tf_point *points,
-                                                                  uint32_t count, uint32_t resolution,
+                                                                  uint32_t count,
+                                                                  uint32_t resolution,
                                                                   umbra_transfer_function *out);
 
 /* Makes tf's entries span data values lo..hi (finite, lo < hi; the volume's units, before its
  * normalisation) instead of the volume's normalised range; renderers pick the change up at their
  * next render. The table itself is unchanged. UMBRA_ERROR_INVALID_ARGUMENT names a bad range. */
-UMBRA_API umbra_status umbra_transfer_function_set_range(umbra_transfer_function tf, float lo, float hi);
+UMBRA_API umbra_status umbra_transfer_function_set_range(umbra_transfer_function tf, float lo,
+                                                         float hi);
 /* Nonzero if tf has a data range; then writes it to range[0..1] (range may be NULL). */
 UMBRA_API int umbra_transfer_function_get_range(umbra_transfer_function tf, float range[2]);
 

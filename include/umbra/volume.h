@@ -66,6 +66,7 @@ typedef struct umbra_volume_desc {
                                 sheared grid is UMBRA_ERROR_UNSUPPORTED naming the angle */
 } umbra_volume_desc;
 
+/* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
 /* Copies the data to the device. Blocks until the upload is done. */
@@ -88,6 +89,8 @@ typedef struct umbra_volume_info {
     float center[3];         /* world position of the box's centre (0 for the centred box) */
 } umbra_volume_info;
 
+/* Describes volume in *out (sizes, world placement, value range, device memory).
+ * UMBRA_ERROR_INVALID_ARGUMENT for NULL volume or out. */
 UMBRA_API umbra_status umbra_volume_get_info(umbra_volume volume, umbra_volume_info *out);
 
 UMBRA_API void umbra_volume_retain(umbra_volume volume);
