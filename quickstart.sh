@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing (Debian 12 packages), builds umbra, and renders the built-in default
 # scene ("spheres") without and with the exact reference shadows into out/.
 # Usage: ./quickstart.sh [build-dir]      (default build-dir: build)

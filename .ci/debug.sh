@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # CI: the Debug configuration (-O0) builds every target with warnings as errors (issue 11, row
 # 15: GCC's -Wformat-truncation fires at -O0 where the Release build's value tracking is silent).
 set -euo pipefail

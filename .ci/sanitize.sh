@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # CI: the whole ctest suite under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/), and
 # the concurrency test under ThreadSanitizer (build-tsan/). Runs from the repository root after
 # .ci/run's normal build in build/ (whose PoCL kernel cache it re-uses: same kernels, same options).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/accuracy.c: `umbra-bench accuracy`, what accuracy costs in time.
  *
  * For every scene of bench/scenes/ (scene_file.h) and every shadow technique this build has, over

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/bench.h: what umbra-bench's subcommands share.
  *
  * umbra-bench is one executable with subcommands (`umbra-bench raycast ...`). Each subcommand

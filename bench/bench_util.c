@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/bench_util.c: see bench.h. Timing, CSV rows, the bonsai (or its procedural stand-in),
  * and a description of the machine. */
 #define _POSIX_C_SOURCE 200809L

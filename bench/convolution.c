@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/convolution.c: `umbra-bench convolution`, the shape of Table 1 of the convolution-shadow
  * paper: slice distance 0.2-0.8 voxel x 0-3 sub-samples, with and without pre-integration; for
  * each setting the time per frame (median of the timed runs after warm-up: device time of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/main.c: umbra-bench, the benchmark driver. `umbra-bench <subcommand> [options]` runs one
  * benchmark; each subcommand lives in its own file (see bench/bench.h for how to add one) and is
  * listed in the table below. Results go to stdout as CSV, commentary to stderr. */

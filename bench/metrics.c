@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/metrics.c: RMSE, PSNR, maximum and mean absolute error and SSIM of two rendered images
  * (definitions in metrics.h). Plain C, no OpenCL, so that tests/test_metrics.c can check it
  * against hand-computed values. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/metrics.h: image error measures for comparing a technique's image with the exact
  * reference of the same scene and view.
  *

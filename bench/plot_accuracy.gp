@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench/plot_accuracy.gp: the plots of `umbra-bench accuracy`, which sets the variables below and
 # loads this file once per scene. To re-plot by hand from a committed CSV, set them with -e, e.g.
 #   gnuplot -e "csv='bench/results/accuracy/accuracy.csv'; scene='walnut'; scene_title='walnut'; \

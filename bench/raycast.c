@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/raycast.c: `umbra-bench raycast`, the foundation's speed check.
  *
  * One view of the bonsai CT (or its procedural stand-in, bench_util.c) at 512x512, view step 0.5

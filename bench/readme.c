@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/readme.c: `umbra-bench readme`, which writes the README's measured sections from the
  * recorded results, so that no figure in the README is typed by hand.
  *

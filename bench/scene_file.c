@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/scene_file.c: parsing the bench's scene files and turning them into umbra objects.
  * The format is described in scene_file.h and bench/README.md. Every error names the file and
  * line, quotes the offending key or value and says what was expected, so that a typo in a scene

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/scene_file.h: the bench's scene files (bench/scenes/NAME.scene).
  *
  * A scene file states everything that fixes one benchmark image: the volume, its transfer

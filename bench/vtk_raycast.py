@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """bench/vtk_raycast.py: VTK's CPU ray caster on the view `umbra-bench raycast` times.
 
 umbra-bench runs this script with the volume, camera, transfer function and sample distance it

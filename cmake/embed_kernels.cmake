@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Turns each kernel source into a C byte array, so the library carries its kernels and needs no
 # install path. Invoked as a script: cmake -DOUT=file.c -DFILES="a.cl|b.h" -P embed_kernels.cmake
 string(REPLACE "|" ";" FILES "${FILES}")

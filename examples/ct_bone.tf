@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # CT bone preset in Hounsfield units (HU): air, fat and soft tissue transparent; contrast-filled
 # vessels and cancellous bone faint red; cortical bone and metal near-white and dense.
 # "range" makes the point values data values: use it on a volume stored in HU (the table is

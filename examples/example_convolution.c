@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* example_convolution: the convolution-shadow paper's Figure 1 with umbra.
  *
  * Renders the carp CT (argv[1], else $UMBRA_DATA_DIR/carp_half.nhdr when it exists, else the

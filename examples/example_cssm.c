@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* example_cssm: the walnut scene of examples/walnut_scene.h (Figure 3 of the CSSM paper) with the
  * colored stochastic shadow map, 13 taps, as in the paper's Figure 3(c). Writes cssm.png to the
  * working directory and prints the shadow build time, render time and shadow memory.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* examples/example_deep.c: the walnut scene (examples/walnut_scene.h) with deep shadow maps
  * (Hadwiger et al. 2006): a 1024^2 map compressed within epsilon = 0.02 with the pre-compressed
  * segment table (deep.png), and the same map with a fixed budget of three nodes per texel -- the

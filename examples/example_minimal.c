@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* example_minimal: the smallest complete use of umbra's API: a built-in scene rendered with the
  * exact reference shadows into a PNG. Usage: example_minimal [out.png] */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* example_reference: the walnut scene of examples/walnut_scene.h (Figure 3 of the CSSM paper)
  * with the exact reference shadows (a shadow ray marched from every sample), the image the
  * shadow-map techniques are compared with. Writes reference.png to the working directory and

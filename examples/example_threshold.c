@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* example_threshold: the walnut scene of examples/walnut_scene.h (Figure 3 of the CSSM paper)
  * with the opacity-threshold shadow map: threshold 0.5 and one tap, the paper's "traditional
  * shadow map" of Figure 3(a). Writes threshold.png to the working directory and prints the shadow

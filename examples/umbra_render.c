@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra-render: the command-line front end. Renders a built-in scene or a volume file with a
  * chosen shadow technique into a PNG or EXR and prints each stage's time to stderr.
  * Run with --help for the options. Exit status (as the README states): 0 on success; 1 on bad

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Walnut CT (examples/walnut_scene.h): shell and kernel both translucent, in different colours,
 # so that light passing through them casts coloured partial shadows (CSSM paper, Figure 3).
 # Values are normalised to the scan's range: air and noise lie below 0.2, the kernel around 0.29,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* examples/walnut_scene.h: the one scene every shadow technique's example renders, so that their
  * images (threshold.png, deep.png, cssm.png, reference.png) can be put side by side: the walnut CT
  * in front of a ground plane, lit by one point light and seen from one camera, like Figure 3 of

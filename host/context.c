@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/context.c: choosing an OpenCL device, owning (or retaining) its context and queue, and
  * the per-context cache of built programs.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/error.c: status names and the one place errors are recorded.
  *
  * The first error since the last umbra_context_take_error sticks; the latest message is kept for

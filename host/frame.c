@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/frame.c: the constants a frame's kernels read (umbra__frame: light, view, box, options),
  * brought up to date from the renderer's state and uploaded; the build options and the kernel
  * arguments every technique's kernels share. */

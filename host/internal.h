@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/internal.h: what the host modules share and the public API does not show.
  *
  * Error recording (one helper, one OpenCL check macro), the context's program cache, and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/lightspace.c: fitting a light-space map to the volume's box. See lightspace.h. */
 #include <math.h>
 #include <string.h>

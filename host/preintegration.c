@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/preintegration.c: the cached pre-integration tables. See preintegration.h. */
 #include <stdlib.h>
 #include <string.h>

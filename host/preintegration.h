@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/preintegration.h: pre-integration tables on the device (kernels/preintegration.cl), shared
  * by the convolution shadows (host/shadow_convolution.c) and the ray caster's pre-integrated mode
  * (host/renderer.c). A table is a cache: it is recomputed only when the transfer function, the

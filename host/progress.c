@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/progress.c: progress reports and cancellation for the renderer's long calls.
  *
  * A render, shadow build or query reports the fraction of its work done to the application's

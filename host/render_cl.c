@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/render_cl.c: rendering into the application's cl_mem, blocking or asynchronous (the
  * checks of include/umbra/context.h's contract points 2 and 3 live here). */
 #include <math.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/renderer.c: the renderer front end: validated state, what each change invalidates, and
  * the frame loop (tables -> shadow structure -> ray caster or the technique's own renderer).
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/renderer_internal.h: the renderer's state and the shadow-technique interface.
  *
  * A shadow technique is a table of functions (umbra__technique) plus, for per-sample techniques,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/scene.c: built-in scenes made in code, so the Quick start, tests and examples need no
  * data files. Each scene comes with its transfer function, camera, light and suggested options. */
 #include <math.h>

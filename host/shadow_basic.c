@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/shadow_basic.c: the two techniques that need no shadow structure: "none" (every point
  * fully lit) and the exact "reference" (a shadow ray per sample, kernels/shadow_reference.c). */
 #include "renderer_internal.h"

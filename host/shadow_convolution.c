@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/shadow_convolution.c: the "convolution" technique: Instant Convolution Shadows with the
  * seed paper's pre-integration and supersampling (ICS, pre-integrated ICS, SCS, pre-integrated
  * SCS, chosen by desc->subsamples and desc->preintegrated). It renders the frame itself with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/shadow_deep.c: the deep shadow map (Hadwiger et al. 2006, after Lokovic and Veach 2000),
  * host side. kernels/shadow_deep.cl has the algorithm; this module owns its device memory:
  *

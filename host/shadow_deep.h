@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/shadow_deep.h: the deep shadow map technique (host/shadow_deep.c, kernels/shadow_deep.cl)
  * and the internals its tests look at: the block layout, the pool and the lookup-table cache. */
 #ifndef UMBRA_SHADOW_DEEP_H

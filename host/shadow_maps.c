@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/shadow_maps.c: the two single-layer light-space shadow maps, which share everything but
  * their kernels: the opacity-threshold map ("threshold", kernels/shadow_threshold.cl) and the
  * colored stochastic shadow map ("cssm", kernels/shadow_cssm.cl, Weidner & Linsen).

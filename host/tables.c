@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/tables.c: the renderer's per-(transfer function, volume, step) tables: step-corrected
  * transfer-function tables (the light's uncorrected, with per-interval depth integrals), and
  * which bricks and sub-cells of the volume those make visible, uploaded once per key and reused

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/transfer_function.c: RGBA transfer-function tables, host copy plus device copy.
  *
  * Tables are validated once here (finite, in [0,1]) so kernels never see a NaN. Renderers derive

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/volume.c: uploading a scalar volume and its empty-space-skipping brick table.
  *
  * Voxels are normalised to [0,1] through the value range and stored as float32, in a buffer (for

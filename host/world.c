@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* host/world.c: the application's world and data units.
  *
  * A volume may carry an index-to-world transform (include/umbra/volume.h); the kernels keep

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // io/image.cpp: writing and reading images through OpenImageIO.
 //
 // umbra renders premultiplied linear RGBA floats. EXR stores them as they are. PNG cannot: it

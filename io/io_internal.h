@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/io_internal.h: what the readers and writers of umbra_io share.
  *
  * umbra_io is built on libumbra's public API alone (it never sees host/internal.h), so that the

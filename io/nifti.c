@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/nifti.c: NIfTI-1 and NIfTI-2 volumes through nifticlib (Debian's libnifti2-dev).
  *
  * nifticlib parses the header (either version, byte order, gzip through its znzlib) and reads the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/nifti.h: the NIfTI reader's host-side result, shared by io/nifti.c and the tests.
  *
  * umbra_volume_load_nifti hands the voxels to umbra_volume_create; this structure also keeps what

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/nrrd.c: reading NRRD volumes (attached .nrrd, detached .nhdr).
  *
  * Teem parses the header; umbra reads the data. Left to itself Teem opens data files by name with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/paraview.c: transfer functions from ParaView's JSON colour-map presets.
  *
  * ParaView keeps colour maps as JSON (File > Export in the Color Map Editor, or the bundled

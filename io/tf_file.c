@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/tf_file.c: reading transfer functions from text files.
  *
  * The format, one item per line:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* io/volume_io.c: reading volumes from files.
  *
  * Two readers, both ending in umbra_volume_create: Voreen's .dat text header over a raw file, and

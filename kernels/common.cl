@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/common.cl: math shared by every umbra program: ray-box intersection, transfer-function
  * lookup, the counter-based random numbers, and the brick walk used for empty-space skipping.
  * It follows umbra_shared.h and precedes sampling.cl in every program. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/convolution.cl: slice-based convolution shadows: Instant Convolution Shadows (ICS,
  * Patel et al. 2009) with the pre-integration and supersampling of "Pre-integration and
  * supersampling for convolution shadows" (the seed paper). It follows common.cl, sampling.cl and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/lightspace.cl: the light-space map projection shared by the shadow-map techniques.
  * host/lightspace.c fits it to the volume's box; see UMBRA_LS_* in umbra_shared.h.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/preintegration.cl: pre-integration tables (Engel, Kraus & Ertl 2001) and their lookup,
  * shared by the convolution shadows (kernels/convolution.cl) and the ray caster's pre-integrated
  * mode (kernels/raycast.cl).

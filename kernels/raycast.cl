@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/raycast.cl: the view-space ray caster.
  *
  * Front-to-back emission-absorption compositing (Max 1995) with early ray termination,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
  * build time (UMBRA_SAMPLER_IMAGE): a float buffer with hand-written trilinear interpolation
  * (fastest on PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture

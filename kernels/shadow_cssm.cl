@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_cssm.cl: colored stochastic shadow maps for direct volume rendering (Weidner &
  * Linsen, after McGuire & Enderton's CSSM for surfaces).
  *

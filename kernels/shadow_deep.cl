@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_deep.cl: deep shadow maps for volume ray casting (Hadwiger, Kratz, Sigg and
  * Buehler 2006, after Lokovic and Veach 2000). Three build stages, compiled (DEEP_BUILD_KERNELS=1)
  * into the build program of host/shadow_deep.c:

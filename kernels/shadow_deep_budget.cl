@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_deep_budget.cl: the deep shadow map with a fixed node budget (shadow max_nodes,
  * `--nodes N`): deep_build_fixed marches every texel like deep_build (kernels/shadow_deep.cl,
  * whose fit and march this file uses; the host's build program appends it after that file) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_none.cl: the "none" shadow technique: every point is fully lit.
  *
  * The shadow-technique interface, which every kernels/shadow_*.cl file implements:

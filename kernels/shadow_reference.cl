@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_reference.cl: the exact reference. From every point, a shadow ray is marched
  * toward the light with step S->step and the optical depth of the shading model (the extinction
  * per channel of kernels/common.cl) is integrated. Every other technique is measured against it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_threshold.cl: the opacity-threshold shadow map ("traditional shadow mapping,
  * where a thresholding at opacity 0.5 is applied", as the CSSM paper compares against).
  *

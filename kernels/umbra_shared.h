@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* kernels/umbra_shared.h: structs shared by the host and the kernels.
  *
  * This file is compiled twice: as C by the host (the host modules include it) and as OpenCL C, prepended

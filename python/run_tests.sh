@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # python/run_tests.sh BUILD_DIR: the Python package's tests (ctest runs this as test_python).
 # Builds and installs python/ with pip into a virtual environment in BUILD_DIR (Debian's pip
 # refuses system installs, PEP 668) and runs its pytest suite, which compares against

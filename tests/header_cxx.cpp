@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Compiles the public API as C++: every declaration must be valid there too.
 #include "umbra/io.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/shadow_map_test.h: checks that the single-layer light-space maps (test_threshold.c,
  * test_cssm.c) share, written once and run per technique:
  *  - a homogeneous slab scene (the whole box filled with one value) and points placed at texel

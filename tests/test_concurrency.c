@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_concurrency.c: umbra on several threads (issue 11, rows 1 and 14).
  *
  *  - several threads creating contexts as the process's first OpenCL use (PoCL's lazy device

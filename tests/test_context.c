@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_context.c: the OpenCL contract between umbra and the application that embeds it
  * (include/umbra/context.h, "The OpenCL contract"), one test per point:
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_convolution.c: the convolution shadows (ICS, pre-integrated ICS, SCS, pre-integrated
  * SCS) and the pre-integration tables they share with the ray caster, pinned down.
  *

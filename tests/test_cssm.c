@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_cssm.c: colored stochastic shadow maps (kernels/shadow_cssm.cl) pinned down.
  *
  * Statistics. A texel's photon is stopped in segment i with probability rho_i given that it got

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_deep.c: the deep shadow map (technique "deep", Hadwiger et al. 2006), pinned down.
  *
  *  - homogeneous slab: the map's visibility along texel rays is within epsilon + a stated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_deep_budget.c: the deep shadow map under a fixed node budget (shadow max_nodes),
  * held against the exact reference technique on the two cases that made the old streaming merge
  * leak light (issue 10, failure 6):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_fidelity.c: the exact reference held to an independent integral (issue 10).
  *
  * fid_transmittance below is a float64 plain-C integral of the shading model's transmittance

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_formats.c: ParaView transfer-function presets and NIfTI volumes (umbra_io).
  *
  * Presets are checked against values worked out independently: linear RGB presets against

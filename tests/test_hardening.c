@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_hardening.c: inputs that used to hang the renderer or give a wrong image with
  * success (issue 11), each pinned down by the case that showed it:
  *

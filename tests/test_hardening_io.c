@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_hardening_io.c: hostile files (issue 11, rows 2, 8, 9, 11, 12, 13).
  *
  * Each test names the case it pins down. FIFOs given as any input (the volume, a .dat's or a

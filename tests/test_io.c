@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_io.c: reading and writing files.
  *
  * Volumes (headerless raw, NRRD through Teem, Voreen .dat), transfer-function text files and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_metrics.c: the accuracy bench's image error measures and scene-file parser.
  *
  * The bench's timing is never tested; what its numbers mean is. The measures (bench/metrics.c)

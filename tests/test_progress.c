@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_progress.c: progress reports and cancellation (issue 11, row 16).
  *
  *  - with a progress callback, every technique reports fractions in [0, 1] that never decrease

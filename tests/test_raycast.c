@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_raycast.c: the foundation's ray caster and exact shadow reference, pinned down.
  *
  *  - the reference shadow factor in a homogeneous volume equals the analytic exp(-sigma d)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_threshold.c: the opacity-threshold shadow map (kernels/shadow_threshold.cl) pinned
  * down:
  *  - homogeneous slab: along a light ray the factor flips from 1 to 0 at the analytic crossing

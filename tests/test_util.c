@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_util.c: see test_util.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "test_util.h"

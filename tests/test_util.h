@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_util.h: helpers every umbra test shares: a context on the CPU (PoCL), a scratch
  * directory, and message checks. */
 #ifndef UMBRA_TEST_UTIL_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/test_world.c: volumes in the application's world, transfer functions in data units.
  *
  * - A volume with an index-to-world transform (translated, turned by 90-degree rotations, with and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # bench/device/run.sh OUT_DIR [args for time_techniques]: builds libumbra alone (no umbra_io, no
 # tests: a compiler, CMake and an OpenCL loader are all it needs) into build-device/, builds
 # time_techniques against it, and writes its table to OUT_DIR/techniques.md.

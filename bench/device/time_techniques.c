@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* bench/device/time_techniques.c: absolute frame and build times of every shadow technique on a
  * built-in scene, on whatever OpenCL device UMBRA_DEVICE (or the default choice) gives.
  *

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Bonsai CT: thin green foliage, a brown trunk, an opaque pot. The foliage is sparse and
 # translucent, the kind of structure that needs partial (not binary) shadows.
 # Format (host/tf_file.c): "value r g b a", alpha per voxel step.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Carp CT (carp_half): translucent flesh, opaque bright bone, so that the skeleton casts soft
 # partial shadows through the body (convolution-shadow paper, Figure 1). Values are normalised to
 # the scan's range: water and noise below 0.28, flesh around 0.35-0.40, bone above 0.45.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Foot CT: skin and soft tissue faint and reddish, bone opaque white. The bones' shadows fall
 # through the translucent tissue onto the ground.
 # Format (host/tf_file.c): "value r g b a", alpha per voxel step.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/context.h: the OpenCL device umbra runs on, and the contract with the application.
  *
  * A context owns the OpenCL context, device and queue (or retains the application's), the cache of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/error.h: status codes and error reporting.
  *
  * Every function that can fail returns an umbra_status. The context keeps the first error since it

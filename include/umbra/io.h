@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, Voreen .dat and raw
  * files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
  * EXR.

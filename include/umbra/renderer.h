@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/renderer.h: direct volume rendering with shadows.
  *
  * A renderer draws one volume with a view transfer function from a camera, lit by one light, and

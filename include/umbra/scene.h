@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/scene.h: built-in scenes made in code, needing no file.
  *
  *   "spheres"        translucent coloured spheres over a ground plane (the default scene)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/transfer_function.h: 1D RGBA transfer functions.
  *
  * A transfer function is a table of RGBA entries spread evenly over the volume's normalised value

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/umbra.h: the whole public API of umbra, an OpenCL library for shadows in direct volume
  * rendering. Include this, or the one header per concept it lists. The optional file layer
  * (umbra_io: NRRD, .dat, raw, transfer-function files, PNG/EXR) has its own header, umbra/io.h. */

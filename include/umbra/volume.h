@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* umbra/volume.h: scalar volumes on the device.
  *
  * A volume is a regular grid of scalars, x fastest, uploaded once. Values are mapped to [0,1]

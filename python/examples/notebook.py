@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Pictures for a Jupyter notebook: umbra renders to a NumPy array; to_uint8() makes it displayable
 (matplotlib's imshow, PIL.Image.fromarray) and show() returns a PIL image, which Jupyter draws
 inline as the cell's value.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Renders a NIfTI volume (read with nibabel) with shadows into a PNG.
 
     python render_nifti.py head.nii.gz head.png --technique cssm

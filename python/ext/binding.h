@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* binding.h: what the parts of the Python module umbra._umbra share: errors raised as umbra.Error,
  * checks of NumPy arrays, the field tables of the bound C option structs, and the wrappers that
  * hold umbra's C objects. module.cpp makes the module; options.cpp binds the option structs

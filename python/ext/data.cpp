@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* data.cpp: Volume, VolumeInfo and TransferFunction, the data a renderer draws, bound with NumPy
  * arrays in: a volume from a (z, y, x) array with its spacing and, optionally, its index-to-world
  * transform (origin and axis directions, as a NIfTI affine or a NRRD's space directions give

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* module.cpp: the Python module umbra._umbra, a nanobind binding of umbra's public C API
  * (umbra/umbra.h) and of its file layer (umbra/io.h); the package umbra re-exports it.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* objects.cpp: Context, Renderer and Scene: umbra's C objects wrapped so that they close
  * deterministically (close(), with) and may be collected in any order (each wrapper retains the
  * C objects it needs, its context included), with NumPy arrays in and out. Volume and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* options.cpp: RenderOptions, ShadowOptions, Camera and Light, the C structs umbra_render_desc,
  * umbra_shadow_desc, umbra_camera and umbra_light bound field by field. Each field is named once,
  * with a pointer to the C member: its type and storage come from the C header, its default from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* support.cpp: the helpers of the Python binding (binding.h): umbra.Error and the checks that turn
  * a wrong NumPy array into a message naming its dtype, shape or strides. */
 #include <cmath>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared fixtures of the Python package's tests: one OpenCL context for the session (PoCL's
 first context is slow to make), the repository root, and the C command-line tool to compare with."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Bad input raises umbra.Error with umbra's status and a message that names the value, and leaves
 the context usable."""
 

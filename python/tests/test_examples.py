@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The examples run: a NIfTI file written with nibabel rendered with shadows, and the notebook
 helpers returning arrays and PNGs."""
 

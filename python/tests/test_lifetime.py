@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Objects close deterministically, survive being collected in any order, and do not leak over a
 thousand create/release cycles."""
 

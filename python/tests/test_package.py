@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The installed package: its version is the C project's, its type stubs are installed and parse,
 and the option classes carry the C defaults (umbra_*_desc_init) in their docstrings."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Progress and cancellation from Python: the fractions a render reports, a callable that cancels
 (umbra.Error with status ERROR_CANCELLED, the renderer usable afterwards), an exception in the
 callable and Ctrl-C (SIGINT) cancelling a render and propagating, and bad callables refused."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Pictures from Python: the same pixels as the C command-line tool on the built-in scene, every
 shadow technique, rendering into a caller's array, shadow queries, the axis order of volumes."""
 

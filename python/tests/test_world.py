@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Volumes placed in the world from Python: origin and directions reach the C library (read back
 through Volume.info), a NIfTI affine handed over as the README says places the volume where
 umbra's own NIfTI loader does, and bad transforms raise umbra.Error naming the problem."""

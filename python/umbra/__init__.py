@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """umbra: shadows in direct volume rendering, on OpenCL, from NumPy.
 
 A binding of the umbra C library (``umbra/umbra.h``) made with nanobind. Arrays go in and out

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # tests/consumer/check.sh SOURCE_DIR BUILD_DIR: umbra as an application takes it in.
 #  1. `cmake --install` into a fresh prefix; nothing installed names the source or build tree.
 #  2. The consumers (a copy of this folder, outside the source tree) build and run against the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* consumer.c: the smallest application on libumbra alone (no umbra_io). It renders the built-in
  * scene with the exact reference shadows and checks the picture is not empty.
  * Usage: consumer_c            render; exit 0 on success

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // consumer.cpp: a C++ application that targets OpenCL 3.0, makes its own context and queue with
 // clCreateCommandQueueWithProperties (a 2.0+ call), hands them to umbra, renders the built-in
 // scene and writes it with umbra_io. Usage: consumer_cxx out.png

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_scene_file.c: libFuzzer harness for the bench's scene files
  * (bench/scene_file.c, scene_parse_text): any text must parse or give a message "path:line: ...",
  * never a crash or sanitizer report. Parsing opens no file (hash_files 0). */

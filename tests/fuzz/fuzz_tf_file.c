@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_tf_file.c: libFuzzer harness for the transfer-function text format
  * (umbra_transfer_function_load, host/tf_file.c): any bytes must give a table or a status with a
  * message, never a crash, hang, leak or sanitizer report. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_util.h: what the libFuzzer harnesses share. The loaders take paths, so each
  * input is written to a file in a per-process directory under $TMPDIR and loaded from there; the
  * context (PoCL) is created once per process and reused, as an application would. */

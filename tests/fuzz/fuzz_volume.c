@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_volume.c: libFuzzer harness for the volume readers through the public API.
  * The first byte picks the reader: 0 an attached NRRD (.nrrd), 1 a detached NRRD (.nhdr) whose
  * data file "data.raw" holds what follows the first "@@" in the input, 2 a Voreen .dat over

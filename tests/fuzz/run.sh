@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # tests/fuzz/run.sh SECONDS [NAME...]: builds the libFuzzer harnesses (clang, ASan + UBSan) in
 # build-fuzz/ if needed and runs each (tf_file, scene_file, volume; or the NAMEs given) for
 # SECONDS on a working copy of its seed corpus (tests/fuzz/corpus/NAME, never written to). Crash

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/reference/cpu_reference.c: see cpu_reference.h. Plain C99 with OpenMP; every formula is
  * restated here from the documented model rather than shared with the library, so a mistake in
  * one is not silently repeated in the other. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* tests/reference/cpu_reference.h: a plain-C implementation of umbra's ray caster and exact
  * shadow reference, written from the algorithm's description (renderer.h's shading model and
  * kernels/raycast.cl's steps) without sharing code with the library. The tests check the OpenCL
