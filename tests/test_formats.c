@@ -35,23 +35,9 @@
 
 /* ---- helpers ------------------------------------------------------------------------------- */
 
-static int setup_context(void **state)
-{
-    *state = test_context();
-    return *state ? 0 : -1;
-}
-
-static int teardown_context(void **state)
-{
-    umbra_context_release((umbra_context)*state);
-    return 0;
-}
-
 static const char *tmp_path(char *buf, const char *name)
 {
-    int n = snprintf(buf, PATH_MAX_LEN, "%s/%s", test_tmpdir(), name);
-    assert_true(n > 0 && n < PATH_MAX_LEN);
-    return buf;
+    return test_tmp_path(buf, PATH_MAX_LEN, name);
 }
 
 /* "<source tree>/<rel>" into buf: UMBRA_TEST_DATA_DIR is "<source tree>/tests/data", which need
@@ -67,71 +53,6 @@ static const char *source_path(char *buf, const char *rel)
     return buf;
 }
 
-static void write_bytes(const char *path, const void *data, size_t size)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, size, f), size);
-    assert_int_equal(fclose(f), 0);
-}
-
-static void write_text(const char *path, const char *text)
-{
-    write_bytes(path, text, strlen(text));
-}
-
-static void *read_bytes(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    long n;
-    void *buf;
-    assert_non_null(f);
-    assert_int_equal(fseek(f, 0, SEEK_END), 0);
-    n = ftell(f);
-    assert_true(n > 0);
-    rewind(f);
-    buf = malloc((size_t)n);
-    assert_non_null(buf);
-    assert_int_equal(fread(buf, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *size = (size_t)n;
-    return buf;
-}
-
-static void assert_context_usable(umbra_context ctx)
-{
-    static const uint8_t voxels[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    umbra_volume_desc desc;
-    umbra_volume vol = NULL;
-    umbra_volume_desc_init(&desc);
-    desc.data = voxels;
-    desc.type = UMBRA_UINT8;
-    desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_int_equal(umbra_volume_create(ctx, &desc, &vol), UMBRA_SUCCESS);
-    umbra_volume_release(vol);
-    assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_SUCCESS);
-}
-
-/* got == expected, the message holds needle (and needle2), and the context still works. */
-static void assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
-                          const char *needle, const char *needle2)
-{
-    const char *msg = umbra_context_last_message(ctx);
-    if (got != expected || !test_message_contains(ctx, needle) ||
-        (needle2 && !test_message_contains(ctx, needle2))) {
-        print_message("got %s, expected %s; message \"%s\"; looked for \"%s\" and \"%s\"\n",
-                      umbra_status_to_string(got), umbra_status_to_string(expected), msg, needle,
-                      needle2 ? needle2 : "");
-    }
-    assert_int_equal(got, expected);
-    assert_true(test_message_contains(ctx, needle));
-    if (needle2) {
-        assert_true(test_message_contains(ctx, needle2));
-    }
-    assert_int_equal(umbra_context_take_error(ctx, NULL), expected);
-    assert_context_usable(ctx);
-}
-
 /* ---- ParaView presets ---------------------------------------------------------------------- */
 
 /* Loads the JSON text as a preset with the given resolution (and range when lo < hi). */
@@ -142,7 +63,7 @@ static umbra_status load_preset(umbra_context ctx, const char *json, const char 
     char path[PATH_MAX_LEN];
     umbra_paraview_options o;
     tmp_path(path, "preset.json");
-    write_text(path, json);
+    test_write_text(path, json);
     umbra_paraview_options_init(&o);
     o.preset = name;
     o.resolution = resolution;
@@ -354,7 +275,7 @@ static void test_paraview_picks_preset_by_name(void **state)
     assert_int_equal(load_preset(ctx, json, "b", 2, 0, 0, &tf, NULL), UMBRA_SUCCESS);
     assert_float_equal(umbra_transfer_function_data(tf)[1], 1.0, 0.0);
     umbra_transfer_function_release(tf);
-    assert_failed(ctx, load_preset(ctx, json, "c", 2, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, load_preset(ctx, json, "c", 2, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
                   "no preset named \"c\"", "among 2");
     assert_null(tf);
 }
@@ -369,7 +290,7 @@ static void test_paraview_through_tf_load_and_shipped_presets(void **state)
     double range[2];
     int i;
     tmp_path(path, "ramp.json");
-    write_text(path, "[{\"RGBPoints\": [5, 0, 0, 0, 6, 1, 1, 1]}]");
+    test_write_text(path, "[{\"RGBPoints\": [5, 0, 0, 0, 6, 1, 1, 1]}]");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     assert_int_equal(umbra_transfer_function_size(tf), 1024);
     assert_float_equal(umbra_transfer_function_data(tf)[4 * 1023], 1.0, 0.0);
@@ -450,7 +371,7 @@ static void test_paraview_bad_presets_named(void **state)
     for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         umbra_transfer_function tf = NULL;
         print_message("case %zu: %s\n", i, cases[i].json);
-        assert_failed(ctx, load_preset(ctx, cases[i].json, NULL, 16, 0, 0, &tf, NULL),
+        test_assert_failed(ctx, load_preset(ctx, cases[i].json, NULL, 16, 0, 0, &tf, NULL),
                       cases[i].status, cases[i].needle, cases[i].needle2);
         assert_null(tf);
     }
@@ -474,14 +395,14 @@ static void test_paraview_bounded(void **state)
     json[len - 1] = ']';
     json[len++] = '}';
     json[len] = '\0';
-    assert_failed(ctx, load_preset(ctx, json, NULL, 16, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, load_preset(ctx, json, NULL, 16, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
                   "RGBPoints has more than 65536 points", NULL);
 
     for (i = 0; i < 5000; ++i) {
         json[i] = '[';
     }
     json[i] = '\0';
-    assert_failed(ctx, load_preset(ctx, json, NULL, 16, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, load_preset(ctx, json, NULL, 16, 0, 0, &tf, NULL), UMBRA_ERROR_FORMAT,
                   "malformed JSON", "nested deeper than 1000");
     free(json);
 
@@ -490,8 +411,8 @@ static void test_paraview_bounded(void **state)
         char where[32];
         snprintf(where, sizeof where, ":1:%zu:", strlen(nul) + 1);
         tmp_path(path, "nul.json");
-        write_bytes(path, nul, sizeof nul - 1);
-        assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
+        test_write_bytes(path, nul, sizeof nul - 1);
+        test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
                       UMBRA_ERROR_FORMAT, "NUL byte", where);
     }
 
@@ -501,17 +422,17 @@ static void test_paraview_bounded(void **state)
     assert_non_null(f);
     assert_int_equal(ftruncate(fileno(f), (off_t)65 << 20), 0);
     fclose(f);
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
                   UMBRA_ERROR_FORMAT, "68157440 bytes", "67108864");
     remove(path);
 
     tmp_path(path, "dir.json");
     assert_int_equal(mkdir(path, 0700), 0);
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, NULL, &tf, NULL),
                   UMBRA_ERROR_IO, "not a regular file", NULL);
     rmdir(path);
     tmp_path(path, "missing.json");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_IO,
                   "missing.json", NULL);
 }
 
@@ -522,22 +443,22 @@ static void test_paraview_bad_arguments(void **state)
     umbra_paraview_options o;
     char path[PATH_MAX_LEN];
     tmp_path(path, "ok.json");
-    write_text(path, "{\"RGBPoints\": [0, 1, 1, 1, 1, 1, 1, 1]}");
+    test_write_text(path, "{\"RGBPoints\": [0, 1, 1, 1, 1, 1, 1, 1]}");
     umbra_paraview_options_init(&o);
     o.resolution = 1;
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
                   UMBRA_ERROR_INVALID_ARGUMENT, "resolution 1 is not in 2..65536", NULL);
     umbra_paraview_options_init(&o);
     o.range_given = 1;
     o.range_min = 5;
     o.range_max = 5;
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
                   UMBRA_ERROR_INVALID_ARGUMENT, "range [5, 5]", NULL);
     umbra_paraview_options_init(&o);
     o.struct_size = 8;
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, path, &o, &tf, NULL),
                   UMBRA_ERROR_INVALID_ARGUMENT, "struct_size is 8", NULL);
-    assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, NULL, NULL, &tf, NULL),
+    test_assert_failed(ctx, umbra_transfer_function_load_paraview(ctx, NULL, NULL, &tf, NULL),
                   UMBRA_ERROR_INVALID_ARGUMENT, "path is NULL", NULL);
     assert_int_equal(umbra_transfer_function_load_paraview(ctx, path, NULL, NULL, NULL),
                      UMBRA_ERROR_INVALID_ARGUMENT);
@@ -813,7 +734,7 @@ static unsigned char *valid_nii(const char *path, size_t *size)
         ((uint16_t *)nim->data)[i] = (uint16_t)i;
     }
     nim_write(nim, path);
-    return read_bytes(path, size);
+    return test_read_bytes(path, size);
 }
 
 /* NIfTI-1 header field offsets (nifti1.h): dim[8] shorts at 40, datatype at 70. */
@@ -842,8 +763,8 @@ static void test_nifti_broken_files_refused(void **state)
     assert_int_equal(size, 352 + 128);
 
     /* Truncated: the header's claim is checked against the file before reading. */
-    write_bytes(tmp_path(bad, "short.nii"), bytes, size - 10);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "holds 470 bytes",
+    test_write_bytes(tmp_path(bad, "short.nii"), bytes, size - 10);
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "holds 470 bytes",
                   "352 + 128");
     assert_null(vol);
 
@@ -851,12 +772,12 @@ static void test_nifti_broken_files_refused(void **state)
     put_i16(bytes, 42, 30000);
     put_i16(bytes, 44, 30000);
     put_i16(bytes, 46, 30000);
-    write_bytes(tmp_path(bad, "huge.nii"), bytes, size);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "holds 480 bytes",
+    test_write_bytes(tmp_path(bad, "huge.nii"), bytes, size);
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "holds 480 bytes",
                   "54000000000000");
     /* The same compressed: bounded by gzip's ratio. */
     write_gz(tmp_path(bad, "huge.nii.gz"), bytes, size);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
                   "compressed bytes, too few", "1032");
 
     /* A second time point. */
@@ -865,8 +786,8 @@ static void test_nifti_broken_files_refused(void **state)
     put_i16(bytes, 44, 2);
     put_i16(bytes, 46, 4);
     put_i16(bytes, 48, 2);
-    write_bytes(tmp_path(bad, "t2.nii"), bytes, size);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "dim 4 (of 4) is 2",
+    test_write_bytes(tmp_path(bad, "t2.nii"), bytes, size);
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT, "dim 4 (of 4) is 2",
                   NULL);
     put_i16(bytes, 40, 3);
     put_i16(bytes, 42, 4);
@@ -878,8 +799,8 @@ static void test_nifti_broken_files_refused(void **state)
     put_i16(bytes, 46, 2);
     put_i16(bytes, 70, DT_COMPLEX64);
     put_i16(bytes, 72, 64);
-    write_bytes(tmp_path(bad, "complex.nii"), bytes, size);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_UNSUPPORTED,
+    test_write_bytes(tmp_path(bad, "complex.nii"), bytes, size);
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_UNSUPPORTED,
                   "datatype COMPLEX64", NULL);
     free(bytes);
 
@@ -888,7 +809,7 @@ static void test_nifti_broken_files_refused(void **state)
         nifti_image *nim = nim_new(DT_FLOAT64, 2, 1, 1, 1);
         ((double *)nim->data)[1] = 1e300;
         nim_write(nim, tmp_path(bad, "big.nii"));
-        assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
+        test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
                       "not a finite float32", "FLOAT64");
     }
 
@@ -902,29 +823,29 @@ static void test_nifti_broken_files_refused(void **state)
             ((uint8_t *)nim->data)[i] = (uint8_t)((i * 7919u) ^ (i >> 3));
         }
         nim_write(nim, tmp_path(bad, "cut.nii.gz"));
-        gz = read_bytes(bad, &gz_size);
-        write_bytes(bad, gz, gz_size / 2);
+        gz = test_read_bytes(bad, &gz_size);
+        test_write_bytes(bad, gz, gz_size / 2);
         free(gz);
-        assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
+        test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
                       "cannot read its 32768 bytes", NULL);
     }
 
-    write_text(tmp_path(bad, "text.nii"), "this is not a NIfTI header\n");
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
+    test_write_text(tmp_path(bad, "text.nii"), "this is not a NIfTI header\n");
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_FORMAT,
                   "is not a NIfTI-1/2 file", "text.nii");
-    assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "missing.nii"), &vol), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "missing.nii"), &vol), UMBRA_ERROR_IO,
                   "cannot open", "missing.nii");
     tmp_path(bad, "dir.nii");
     assert_int_equal(mkdir(bad, 0700), 0);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_IO, "not a regular file",
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_IO, "not a regular file",
                   NULL);
     rmdir(bad);
     tmp_path(bad, "fifo.nii.gz");
     assert_int_equal(mkfifo(bad, 0600), 0);
-    assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_IO, "not a regular file",
+    test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_IO, "not a regular file",
                   NULL);
     remove(bad);
-    assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "x.mha"), &vol),
+    test_assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "x.mha"), &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "unknown extension", "MetaImage");
     assert_int_equal(umbra_volume_load_nifti(ctx, path, NULL), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_ERROR_INVALID_ARGUMENT);
@@ -999,7 +920,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_paraview_defaults),
-#define T(t) cmocka_unit_test_setup_teardown(t, setup_context, teardown_context)
+#define T(t) cmocka_unit_test_setup_teardown(t, test_group_setup, test_group_teardown)
         T(test_paraview_rgb_matches_points),
         T(test_paraview_explicit_range),
         T(test_paraview_midpoint_and_sharpness),

@@ -38,50 +38,7 @@
 
 static const char *tmp_path(char *buf, const char *name)
 {
-    int n = snprintf(buf, PATH_LEN, "%s/%s", test_tmpdir(), name);
-    assert_true(n > 0 && n < PATH_LEN);
-    return buf;
-}
-
-static void write_bytes(const char *path, const void *data, size_t size)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, size, f), size);
-    assert_int_equal(fclose(f), 0);
-}
-
-static void write_text(const char *path, const char *text)
-{
-    write_bytes(path, text, strlen(text));
-}
-
-/* The call failed with status expected, its message holds both needles (needle2 may be NULL), and
- * the context still creates a volume. */
-static void assert_refused(umbra_context ctx, umbra_status got, umbra_status expected,
-                           const char *needle, const char *needle2)
-{
-    static const uint8_t voxels[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    umbra_volume_desc desc;
-    umbra_volume vol = NULL;
-    if (got != expected || !test_message_contains(ctx, needle) ||
-        (needle2 && !test_message_contains(ctx, needle2))) {
-        print_message("got %s, expected %s; message \"%s\"; looked for \"%s\" and \"%s\"\n",
-                      umbra_status_to_string(got), umbra_status_to_string(expected),
-                      umbra_context_last_message(ctx), needle, needle2 ? needle2 : "");
-    }
-    assert_int_equal(got, expected);
-    assert_true(test_message_contains(ctx, needle));
-    if (needle2) {
-        assert_true(test_message_contains(ctx, needle2));
-    }
-    assert_int_equal(umbra_context_take_error(ctx, NULL), expected);
-    umbra_volume_desc_init(&desc);
-    desc.data = voxels;
-    desc.type = UMBRA_UINT8;
-    desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_int_equal(umbra_volume_create(ctx, &desc, &vol), UMBRA_SUCCESS);
-    umbra_volume_release(vol);
+    return test_tmp_path(buf, PATH_LEN, name);
 }
 
 /* ---- row 2: FIFOs ------------------------------------------------------------------------------ */
@@ -174,20 +131,20 @@ static void test_fifo_inputs_are_refused_without_blocking(void **state)
     assert_int_equal(mkfifo(fifo, 0600), 0);
 
     /* --raw, --tf, an image, and a FIFO named as the volume file itself. */
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_RAW, fifo, fifo), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_RAW, fifo, fifo), UMBRA_ERROR_IO,
                    "not a regular file", "FIFO");
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_TF, fifo, fifo), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_TF, fifo, fifo), UMBRA_ERROR_IO,
                    "not a regular file", fifo);
     tmp_path(link, "fifo_image.png");
     unlink(link);
     assert_int_equal(symlink(fifo, link), 0);
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_IMAGE, link, fifo), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_IMAGE, link, fifo), UMBRA_ERROR_IO,
                    "not a regular file", link);
     unlink(link);
     tmp_path(link, "fifo_volume.nrrd");
     unlink(link);
     assert_int_equal(symlink(fifo, link), 0);
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_VOLUME, link, fifo), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_VOLUME, link, fifo), UMBRA_ERROR_IO,
                    "not a regular file", "FIFO");
     unlink(link);
 
@@ -196,8 +153,8 @@ static void test_fifo_inputs_are_refused_without_blocking(void **state)
              "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
              "data file: %s\n",
              fifo);
-    write_text(tmp_path(nhdr, "fifo_data.nhdr"), text);
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_VOLUME, nhdr, fifo), UMBRA_ERROR_IO,
+    test_write_text(tmp_path(nhdr, "fifo_data.nhdr"), text);
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_VOLUME, nhdr, fifo), UMBRA_ERROR_IO,
                    fifo, "not a regular file");
     remove(nhdr);
 
@@ -205,8 +162,8 @@ static void test_fifo_inputs_are_refused_without_blocking(void **state)
     snprintf(text, sizeof text,
              "ObjectFileName: %s\nResolution: 2 2 2\nSliceThickness: 1 1 1\nFormat: UCHAR\n",
              fifo);
-    write_text(tmp_path(dat, "fifo_data.dat"), text);
-    assert_refused(ctx, load_without_blocking(ctx, LOAD_VOLUME, dat, fifo), UMBRA_ERROR_IO, fifo,
+    test_write_text(tmp_path(dat, "fifo_data.dat"), text);
+    test_assert_failed(ctx, load_without_blocking(ctx, LOAD_VOLUME, dat, fifo), UMBRA_ERROR_IO, fifo,
                    "not a regular file");
     remove(dat);
     unlink(fifo);
@@ -221,11 +178,11 @@ static void test_nrrd_declaring_more_than_the_file_holds_is_refused_before_alloc
     umbra_context ctx = *state;
     char path[PATH_LEN];
     umbra_volume vol = NULL;
-    write_text(tmp_path(path, "huge_claim.nrrd"),
+    test_write_text(tmp_path(path, "huge_claim.nrrd"),
                "NRRD0004\n# a header declaring 4 GiB of voxels over 4 bytes of data\n"
                "type: uchar\ndimension: 3\nsizes: 2147483648 2 1\nencoding: raw\n"
                "spacings: 1 1 1\n\nabcd");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "2147483648 x 2 x 1", "4294967296 bytes) do not match the 4 bytes");
     assert_null(vol);
 
@@ -236,8 +193,8 @@ static void test_nrrd_declaring_more_than_the_file_holds_is_refused_before_alloc
         unsigned char file[sizeof head - 1 + 64];
         memcpy(file, head, sizeof head - 1);
         memset(file + sizeof head - 1, 0x1f, 64);
-        write_bytes(path, file, sizeof file);
-        assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+        test_write_bytes(path, file, sizeof file);
+        test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                        "1024 x 1024 x 1024", "1032:1");
     }
     remove(path);
@@ -251,44 +208,44 @@ static void test_nrrd_detached_data_must_be_a_regular_file_of_the_declared_size(
     unsigned char bytes[100];
 
     tmp_path(nhdr, "detached_hostile.nhdr");
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: /dev/zero\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/dev/zero",
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/dev/zero",
                    "not a regular file (a character device)");
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: /dev/stdin\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/dev/stdin",
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/dev/stdin",
                    "not a regular file");
     /* A directory, and Teem's "-" (stdin to Teem; here a file name that does not exist). */
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: /\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "\"/\"",
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "\"/\"",
                    "a directory");
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: -\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/-\"",
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_IO, "/-\"",
                    "No such file");
 
     /* A regular file that is not this volume's data (like /etc/passwd): 100 bytes for 8. */
     memset(bytes, 'x', sizeof bytes);
-    write_bytes(tmp_path(data, "not_the_data.txt"), bytes, sizeof bytes);
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_bytes(tmp_path(data, "not_the_data.txt"), bytes, sizeof bytes);
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: not_the_data.txt\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
                    "(8 bytes) do not match the 100 bytes", "not_the_data.txt");
     /* Shorter than declared. */
-    write_bytes(data, bytes, 7);
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(data, bytes, 7);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
                    "do not match the 7 bytes", NULL);
     /* Exactly right loads. */
-    write_bytes(data, bytes, 8);
+    test_write_bytes(data, bytes, 8);
     assert_int_equal(umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_SUCCESS);
     umbra_volume_release(vol);
     vol = NULL;
     /* Data split over several files is refused by name, not half-read. */
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "data file: LIST\nnot_the_data.txt\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT, "LIST",
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT, "LIST",
                    "only one data file");
     remove(data);
     remove(nhdr);
@@ -340,8 +297,8 @@ static void test_corrupt_gzip_and_zrl_nrrd_fail_without_leaking(void **state)
 
     memcpy(file, gz_head, sizeof gz_head - 1);
     memcpy(file + sizeof gz_head - 1, gz_body, sizeof gz_body);
-    write_bytes(tmp_path(path, "corrupt_gzip.nrrd"), file, sizeof gz_head - 1 + sizeof gz_body);
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(tmp_path(path, "corrupt_gzip.nrrd"), file, sizeof gz_head - 1 + sizeof gz_body);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "corrupt gzip data", path);
     grown = heap_growth_of_failing_loads(ctx, path, 40);
     print_message("corrupt gzip: heap grew %zu bytes over 40 failing loads\n", grown);
@@ -351,22 +308,22 @@ static void test_corrupt_gzip_and_zrl_nrrd_fail_without_leaking(void **state)
 
     memcpy(file, zrl_head, sizeof zrl_head - 1);
     memcpy(file + sizeof zrl_head - 1, zrl_body, sizeof zrl_body);
-    write_bytes(tmp_path(path, "malformed.nrrd"), file, sizeof zrl_head - 1 + sizeof zrl_body);
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(tmp_path(path, "malformed.nrrd"), file, sizeof zrl_head - 1 + sizeof zrl_body);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "malformed ZRL data", path);
     grown = heap_growth_of_failing_loads(ctx, path, 40);
     print_message("malformed ZRL: heap grew %zu bytes over 40 failing loads\n", grown);
     assert_true(grown < 4096);
     /* A header missing a required field: refused before Teem, whose consistency check would
      * leak 88 bytes a load on this path. */
-    write_text(path, "NRRD0004\ntype: ushort\ndimension: 3\nendian: little\nencoding: raw\n\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_text(path, "NRRD0004\ntype: ushort\ndimension: 3\nendian: little\nencoding: raw\n\n");
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "no \"sizes\" field", NULL);
     grown = heap_growth_of_failing_loads(ctx, path, 40);
     assert_true(grown < 1024);
     /* Truncated ZRL: ends before the declared size. */
-    write_bytes(path, file, sizeof zrl_head - 1 + 2);
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(path, file, sizeof zrl_head - 1 + 2);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "ZRL data ends after 2 of the 4096 bytes", NULL);
     remove(path);
 }
@@ -462,8 +419,8 @@ static void test_nrrd_skips_and_zrl_decode(void **state)
     static const unsigned char zrl_body[] = {5, 0, 6, 9};
     unsigned char file[128];
 
-    write_bytes(tmp_path(data, "skipped.bin"), skipped, sizeof skipped - 1);
-    write_text(tmp_path(nhdr, "skipped.nhdr"),
+    test_write_bytes(tmp_path(data, "skipped.bin"), skipped, sizeof skipped - 1);
+    test_write_text(tmp_path(nhdr, "skipped.nhdr"),
                "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                "line skip: 2\nbyte skip: 3\ndata file: skipped.bin\n");
     assert_int_equal(umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_SUCCESS);
@@ -471,15 +428,15 @@ static void test_nrrd_skips_and_zrl_decode(void **state)
     assert_float_equal(info.value_min, 1.0, 0.0);
     assert_float_equal(info.value_max, 9.0, 0.0);
     umbra_volume_release(vol);
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "byte skip: -1\ndata file: skipped.bin\n");
     assert_int_equal(umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_SUCCESS);
     assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
     assert_float_equal(info.value_min, 1.0, 0.0);
     umbra_volume_release(vol);
-    write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+    test_write_text(nhdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                      "line skip: 9\ndata file: skipped.bin\n");
-    assert_refused(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_ERROR_FORMAT,
                    "skipping line 3 of 9", "skipped.bin");
     remove(nhdr);
     remove(data);
@@ -488,7 +445,7 @@ static void test_nrrd_skips_and_zrl_decode(void **state)
     {
         static const char be[] = "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 1 1\n"
                                  "endian: big\nencoding: raw\n\n\x01\x00\x00\x02";
-        write_bytes(tmp_path(nhdr, "be.nrrd"), be, sizeof be - 1);
+        test_write_bytes(tmp_path(nhdr, "be.nrrd"), be, sizeof be - 1);
         assert_int_equal(umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_SUCCESS);
         assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
         assert_float_equal(info.value_min, 2.0, 0.0);
@@ -499,7 +456,7 @@ static void test_nrrd_skips_and_zrl_decode(void **state)
 
     memcpy(file, zrl_head, sizeof zrl_head - 1);
     memcpy(file + sizeof zrl_head - 1, zrl_body, sizeof zrl_body);
-    write_bytes(tmp_path(nhdr, "zrl.nrrd"), file, sizeof zrl_head - 1 + sizeof zrl_body);
+    test_write_bytes(tmp_path(nhdr, "zrl.nrrd"), file, sizeof zrl_head - 1 + sizeof zrl_body);
     assert_int_equal(umbra_volume_load_nrrd(ctx, nhdr, &vol), UMBRA_SUCCESS);
     vox = read_back(vol, 8);
     assert_float_equal(vox[0], 5.0 / 9.0, 1e-6);
@@ -526,7 +483,7 @@ static void test_tf_more_points_than_the_limit_is_refused(void **state)
         pts[i].value = (float)i / (float)(n - 1);
         pts[i].rgba[3] = 0.5f;
     }
-    assert_refused(ctx, umbra_transfer_function_create_from_points(ctx, pts, n, 256, &tf),
+    test_assert_failed(ctx, umbra_transfer_function_create_from_points(ctx, pts, n, 256, &tf),
                    UMBRA_ERROR_INVALID_ARGUMENT, "count 65537", "at most 65536");
     assert_null(tf);
     /* The limit itself is allowed. */
@@ -542,7 +499,7 @@ static void test_tf_more_points_than_the_limit_is_refused(void **state)
         fprintf(f, "%.9f 0 0 0 0.5\n", (double)i / (double)(n - 1));
     }
     assert_int_equal(fclose(f), 0);
-    assert_refused(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
                    "control point 65537", "at most 65536");
     remove(path);
     free(pts);
@@ -562,12 +519,12 @@ static void test_tf_resolution_is_parsed_strictly(void **state)
     for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         char text[128];
         snprintf(text, sizeof text, "resolution %s\n0 0 0 0 0\n1 1 1 1 1\n", bad[i]);
-        write_text(path, text);
-        assert_refused(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
+        test_write_text(path, text);
+        test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
                        bad[i], "integer N in 2..65536");
         assert_null(tf);
     }
-    write_text(path, "resolution 65536\n0 0 0 0 0\n1 1 1 1 1\n");
+    test_write_text(path, "resolution 65536\n0 0 0 0 0\n1 1 1 1 1\n");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     assert_int_equal(umbra_transfer_function_size(tf), 65536);
     umbra_transfer_function_release(tf);

@@ -30,75 +30,10 @@
 
 /* ---- fixtures and helpers ------------------------------------------------------------------ */
 
-static int setup_context(void **state)
-{
-    *state = test_context();
-    return *state ? 0 : -1;
-}
-
-static int teardown_context(void **state)
-{
-    umbra_context_release((umbra_context)*state);
-    return 0;
-}
-
 /* "<tmpdir>/<name>" into buf. */
 static const char *tmp_path(char *buf, const char *name)
 {
-    int n = snprintf(buf, PATH_MAX_LEN, "%s/%s", test_tmpdir(), name);
-    assert_true(n > 0 && n < PATH_MAX_LEN);
-    return buf;
-}
-
-static void write_bytes(const char *path, const void *data, size_t size)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, size, f), size);
-    assert_int_equal(fclose(f), 0);
-}
-
-static void write_text(const char *path, const char *text)
-{
-    write_bytes(path, text, strlen(text));
-}
-
-/* The context recorded exactly this failure and still works: the sticky error holds the code, and
- * a small volume can be created afterwards. */
-static void assert_context_usable(umbra_context ctx)
-{
-    static const uint8_t voxels[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    umbra_volume_desc desc;
-    umbra_volume vol = NULL;
-    umbra_volume_desc_init(&desc);
-    desc.data = voxels;
-    desc.type = UMBRA_UINT8;
-    desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_int_equal(umbra_volume_create(ctx, &desc, &vol), UMBRA_SUCCESS);
-    assert_non_null(vol);
-    umbra_volume_release(vol);
-    assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_SUCCESS);
-}
-
-/* A call failed with status expected and a message containing needle (and needle2 if not NULL);
- * the context is left usable. */
-static void assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
-                          const char *needle, const char *needle2)
-{
-    const char *msg = umbra_context_last_message(ctx);
-    if (got != expected || !test_message_contains(ctx, needle) ||
-        (needle2 && !test_message_contains(ctx, needle2))) {
-        print_message("got %s, expected %s; message \"%s\"; looked for \"%s\" and \"%s\"\n",
-                      umbra_status_to_string(got), umbra_status_to_string(expected), msg, needle,
-                      needle2 ? needle2 : "");
-    }
-    assert_int_equal(got, expected);
-    assert_true(test_message_contains(ctx, needle));
-    if (needle2) {
-        assert_true(test_message_contains(ctx, needle2));
-    }
-    assert_int_equal(umbra_context_take_error(ctx, NULL), expected);
-    assert_context_usable(ctx);
+    return test_tmp_path(buf, PATH_MAX_LEN, name);
 }
 
 /* Reads a volume's normalised voxels back from the device. */
@@ -191,7 +126,7 @@ static void test_raw_little_endian_skips_header_and_normalises(void **state)
         bytes[3 + 2 * i + 1] = (unsigned char)(values[i] >> 8);
         raw[i] = values[i];
     }
-    write_bytes(tmp_path(path, "le.raw"), bytes, sizeof bytes);
+    test_write_bytes(tmp_path(path, "le.raw"), bytes, sizeof bytes);
     umbra_raw_desc_init(&desc);
     desc.type = UMBRA_UINT16;
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
@@ -220,7 +155,7 @@ static void test_raw_big_endian_swaps(void **state)
         bytes[2 * i + 1] = (unsigned char)(values[i] & 0xff);
         raw[i] = values[i];
     }
-    write_bytes(tmp_path(path, "be.raw"), bytes, sizeof bytes);
+    test_write_bytes(tmp_path(path, "be.raw"), bytes, sizeof bytes);
     umbra_raw_desc_init(&desc);
     desc.type = UMBRA_UINT16;
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
@@ -251,7 +186,7 @@ static void test_raw_big_endian_float32_and_int16_swap(void **state)
         }
         raw[i] = fvalues[i];
     }
-    write_bytes(tmp_path(path, "be_float.raw"), bytes, 16);
+    test_write_bytes(tmp_path(path, "be_float.raw"), bytes, 16);
     umbra_raw_desc_init(&desc);
     desc.type = UMBRA_FLOAT32;
     desc.dims[0] = 4;
@@ -268,7 +203,7 @@ static void test_raw_big_endian_float32_and_int16_swap(void **state)
         bytes[2 * i + 1] = (unsigned char)(u & 0xff);
         raw[i] = svalues[i];
     }
-    write_bytes(tmp_path(path, "be_short.raw"), bytes, 8);
+    test_write_bytes(tmp_path(path, "be_short.raw"), bytes, 8);
     desc.type = UMBRA_INT16;
     vol = NULL;
     assert_int_equal(umbra_volume_load_raw(ctx, path, &desc, &vol), UMBRA_SUCCESS);
@@ -284,18 +219,18 @@ static void test_raw_size_mismatch_names_both_sizes(void **state)
     unsigned char bytes[15] = {0};
     umbra_raw_desc desc;
     umbra_volume vol = (umbra_volume)&desc; /* must be reset to NULL */
-    write_bytes(tmp_path(path, "short.raw"), bytes, sizeof bytes);
+    test_write_bytes(tmp_path(path, "short.raw"), bytes, sizeof bytes);
     umbra_raw_desc_init(&desc);
     desc.type = UMBRA_UINT16;
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol), UMBRA_ERROR_FORMAT,
                   "holds 15 bytes", "expected 16");
     assert_null(vol);
     assert_true(test_message_contains(ctx, "umbra_volume_load_raw"));
 
     /* The header counts too: 15 bytes = 16 expected + 1 header byte is still wrong. */
     desc.header_bytes = 1;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol), UMBRA_ERROR_FORMAT,
                   "expected 17", path);
     remove(path);
 }
@@ -308,11 +243,11 @@ static void test_raw_missing_file_is_io_error(void **state)
     umbra_volume vol = NULL;
     umbra_raw_desc_init(&desc);
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, tmp_path(path, "absent.raw"), &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, tmp_path(path, "absent.raw"), &desc, &vol),
                   UMBRA_ERROR_IO, path, "No such file");
     assert_null(vol);
     /* A directory is not a volume either. */
-    assert_failed(ctx, umbra_volume_load_raw(ctx, test_tmpdir(), &desc, &vol), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, test_tmpdir(), &desc, &vol), UMBRA_ERROR_IO,
                   test_tmpdir(), "not a regular file");
 }
 
@@ -323,34 +258,34 @@ static void test_raw_invalid_desc_is_invalid_argument(void **state)
     unsigned char bytes[8] = {0};
     umbra_raw_desc desc;
     umbra_volume vol = NULL;
-    write_bytes(tmp_path(path, "eight.raw"), bytes, sizeof bytes);
+    test_write_bytes(tmp_path(path, "eight.raw"), bytes, sizeof bytes);
 
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, NULL, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, NULL, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "umbra_volume_load_raw", "desc");
     umbra_raw_desc_init(&desc);
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, NULL, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, NULL, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "umbra_volume_load_raw", "path");
     desc.struct_size = 0;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "struct_size", NULL);
     umbra_raw_desc_init(&desc);
     desc.dims[0] = 2;
     desc.dims[1] = 0;
     desc.dims[2] = 4;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "2 x 0 x 4", NULL);
     desc.dims[1] = 1;
     desc.type = (umbra_scalar_type)42;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "type 42", NULL);
     desc.type = UMBRA_UINT8;
     desc.spacing[2] = NAN;
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "spacing", NULL);
     desc.spacing[2] = 1.0f;
     desc.dims[0] = desc.dims[1] = desc.dims[2] = 0x80000000u; /* product overflows size_t */
-    assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
+    test_assert_failed(ctx, umbra_volume_load_raw(ctx, path, &desc, &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "too many voxels", NULL);
     assert_null(vol);
     remove(path);
@@ -375,8 +310,8 @@ static void test_nrrd_detached_header_loads(void **state)
         bytes[2 * i + 1] = (unsigned char)(u & 0xff);
         raw[i] = values[i];
     }
-    write_bytes(tmp_path(data, "detached_data.raw"), bytes, sizeof bytes);
-    write_text(tmp_path(nhdr, "detached.nhdr"), "NRRD0004\n"
+    test_write_bytes(tmp_path(data, "detached_data.raw"), bytes, sizeof bytes);
+    test_write_text(tmp_path(nhdr, "detached.nhdr"), "NRRD0004\n"
                                                 "# a detached header\n"
                                                 "type: short\n"
                                                 "dimension: 3\n"
@@ -422,7 +357,7 @@ static void test_nrrd_attached_space_directions_give_spacing(void **state)
         raw[i] = voxels[i];
     }
     /* Upper-case extension: the dispatch ignores case. */
-    write_bytes(tmp_path(path, "attached.NRRD"), file, sizeof file);
+    test_write_bytes(tmp_path(path, "attached.NRRD"), file, sizeof file);
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
     assert_volume(vol, 2, 2, 2, spacing, raw, 10.0, 90.0);
     umbra_volume_release(vol);
@@ -455,7 +390,7 @@ static void test_nrrd_space_origin_and_directions_give_world(void **state)
     size_t i;
     memcpy(file, header, sizeof header - 1);
     memcpy(file + sizeof header - 1, voxels, 8);
-    write_bytes(tmp_path(path, "world.nrrd"), file, sizeof file);
+    test_write_bytes(tmp_path(path, "world.nrrd"), file, sizeof file);
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
     assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
     assert_int_equal(info.transform_given, 1);
@@ -472,7 +407,7 @@ static void test_nrrd_space_origin_and_directions_give_world(void **state)
     umbra_volume_release(vol);
 
     /* Without space directions the box stays centred. */
-    write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspacings: 1 2 3\n"
+    test_write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspacings: 1 2 3\n"
                      "encoding: raw\n\n12345678");
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
     assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
@@ -482,10 +417,10 @@ static void test_nrrd_space_origin_and_directions_give_world(void **state)
     umbra_volume_release(vol);
 
     /* A sheared grid (axes 45 degrees apart, as a tilted CT gantry makes) is refused. */
-    write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nspace: 3D-right-handed\n"
+    test_write_text(path, "NRRD0004\ntype: uchar\ndimension: 3\nspace: 3D-right-handed\n"
                      "sizes: 2 2 2\nspace directions: (1,0,0) (1,1,0) (0,0,1)\n"
                      "encoding: raw\n\n12345678");
-    assert_failed(ctx, umbra_volume_load(ctx, path, &vol), UMBRA_ERROR_UNSUPPORTED,
+    test_assert_failed(ctx, umbra_volume_load(ctx, path, &vol), UMBRA_ERROR_UNSUPPORTED,
                   "index axes 0 and 1 meet at 45.000 degrees", "sheared");
     assert_null(vol);
     remove(path);
@@ -514,7 +449,7 @@ static void test_nrrd_4d_with_leading_size1_axis_loads(void **state)
     for (i = 0; i < 4; ++i) {
         raw[i] = voxels[i];
     }
-    write_bytes(tmp_path(path, "four_d.nrrd"), file, sizeof file);
+    test_write_bytes(tmp_path(path, "four_d.nrrd"), file, sizeof file);
     assert_int_equal(umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_SUCCESS);
     assert_volume(vol, 2, 1, 2, spacing, raw, -1.0, 3.0);
     umbra_volume_release(vol);
@@ -526,8 +461,8 @@ static void test_nrrd_broken_header_is_format_error(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     umbra_volume vol = (umbra_volume)&path;
-    write_text(tmp_path(path, "garbage.nrrd"), "this is not a nrrd file\n\x01\x02\x03");
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT, path,
+    test_write_text(tmp_path(path, "garbage.nrrd"), "this is not a nrrd file\n\x01\x02\x03");
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT, path,
                   "umbra_volume_load_nrrd");
     assert_null(vol);
     /* Teem's own reason is in the message, and nothing is left in its process-wide store. */
@@ -542,13 +477,13 @@ static void test_nrrd_missing_data_file_is_io_error(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     umbra_volume vol = NULL;
-    write_text(tmp_path(path, "orphan.nhdr"), "NRRD0004\n"
+    test_write_text(tmp_path(path, "orphan.nhdr"), "NRRD0004\n"
                                               "type: uchar\n"
                                               "dimension: 3\n"
                                               "sizes: 2 2 2\n"
                                               "encoding: raw\n"
                                               "data file: orphan_absent.raw\n");
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_IO,
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_IO,
                   "orphan_absent.raw", "No such file");
     assert_int_equal(biffCheck(NRRD), 0);
     remove(path);
@@ -559,9 +494,9 @@ static void test_nrrd_missing_file_is_io_error(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     umbra_volume vol = NULL;
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, tmp_path(path, "absent.nhdr"), &vol),
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, tmp_path(path, "absent.nhdr"), &vol),
                   UMBRA_ERROR_IO, path, "No such file");
-    assert_failed(ctx, umbra_volume_load(ctx, path, &vol), UMBRA_ERROR_IO, path, NULL);
+    test_assert_failed(ctx, umbra_volume_load(ctx, path, &vol), UMBRA_ERROR_IO, path, NULL);
 }
 
 static void test_nrrd_unsupported_type_names_type(void **state)
@@ -578,8 +513,8 @@ static void test_nrrd_unsupported_type_names_type(void **state)
     unsigned char file[sizeof header - 1 + 8] = {0};
     umbra_volume vol = NULL;
     memcpy(file, header, sizeof header - 1);
-    write_bytes(tmp_path(path, "double.nrrd"), file, sizeof file);
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(tmp_path(path, "double.nrrd"), file, sizeof file);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                   "type double", path);
     assert_null(vol);
     remove(path);
@@ -598,8 +533,8 @@ static void test_nrrd_2d_is_format_error(void **state)
     unsigned char file[sizeof header - 1 + 4] = {0};
     umbra_volume vol = NULL;
     memcpy(file, header, sizeof header - 1);
-    write_bytes(tmp_path(path, "image.nrrd"), file, sizeof file);
-    assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
+    test_write_bytes(tmp_path(path, "image.nrrd"), file, sizeof file);
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                   "dimension 2", path);
     remove(path);
 }
@@ -608,14 +543,14 @@ static void test_volume_load_unknown_extension(void **state)
 {
     umbra_context ctx = *state;
     umbra_volume vol = (umbra_volume)state;
-    assert_failed(ctx, umbra_volume_load(ctx, "/no/such/dir/volume.raw", &vol),
+    test_assert_failed(ctx, umbra_volume_load(ctx, "/no/such/dir/volume.raw", &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "/no/such/dir/volume.raw", ".nrrd");
     assert_null(vol);
     assert_true(test_message_contains(ctx, ".nhdr"));
     assert_true(test_message_contains(ctx, ".dat"));
-    assert_failed(ctx, umbra_volume_load(ctx, "no_extension", &vol),
+    test_assert_failed(ctx, umbra_volume_load(ctx, "no_extension", &vol),
                   UMBRA_ERROR_INVALID_ARGUMENT, "no_extension", NULL);
-    assert_failed(ctx, umbra_volume_load(ctx, NULL, &vol), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_volume_load(ctx, NULL, &vol), UMBRA_ERROR_INVALID_ARGUMENT,
                   "umbra_volume_load", "path");
 }
 
@@ -656,10 +591,10 @@ static void test_dat_loads(void **state)
     for (i = 0; i < 12; ++i) {
         raw[i] = values[i];
     }
-    write_bytes(tmp_path(data, "voreen_data.raw"), values, sizeof values);
+    test_write_bytes(tmp_path(data, "voreen_data.raw"), values, sizeof values);
     /* The raw file is named relative to the .dat (the tests do not run in tmpdir); keys Voreen
      * writes that umbra does not need are ignored; CRLF line ends are fine. */
-    write_text(tmp_path(dat, "voreen.dat"), "ObjectFileName:\tvoreen_data.raw\r\n"
+    test_write_text(tmp_path(dat, "voreen.dat"), "ObjectFileName:\tvoreen_data.raw\r\n"
                                             "TaggedFileName: ---\r\n"
                                             "Resolution: 2 3 2\r\n"
                                             "SliceThickness: 1 0.5 2\r\n"
@@ -686,16 +621,16 @@ static void test_dat_missing_key(void **state)
     char dat[PATH_MAX_LEN], data[PATH_MAX_LEN];
     static const unsigned char voxels[8] = {0};
     umbra_volume vol = NULL;
-    write_bytes(tmp_path(data, "nores_data.raw"), voxels, sizeof voxels);
-    write_text(tmp_path(dat, "nores.dat"), "ObjectFileName: nores_data.raw\n"
+    test_write_bytes(tmp_path(data, "nores_data.raw"), voxels, sizeof voxels);
+    test_write_text(tmp_path(dat, "nores.dat"), "ObjectFileName: nores_data.raw\n"
                                            "SliceThickness: 1 1 1\n"
                                            "Format: UCHAR\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "Resolution",
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "Resolution",
                   dat);
-    write_text(dat, "ObjectFileName: nores_data.raw\n"
+    test_write_text(dat, "ObjectFileName: nores_data.raw\n"
                     "Resolution: 2 2 2\n"
                     "Format: UCHAR\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT,
                   "SliceThickness", dat);
     assert_null(vol);
     remove(dat);
@@ -708,24 +643,24 @@ static void test_dat_bad_values_are_named(void **state)
     char dat[PATH_MAX_LEN], data[PATH_MAX_LEN];
     static const unsigned char voxels[8] = {0};
     umbra_volume vol = NULL;
-    write_bytes(tmp_path(data, "bad_data.raw"), voxels, sizeof voxels);
+    test_write_bytes(tmp_path(data, "bad_data.raw"), voxels, sizeof voxels);
     tmp_path(dat, "bad.dat");
-    write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 1 1\n"
+    test_write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 1 1\n"
                     "Format: DOUBLE\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "DOUBLE", dat);
-    write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 x 2\nSliceThickness: 1 1 1\n"
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "DOUBLE", dat);
+    test_write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 x 2\nSliceThickness: 1 1 1\n"
                     "Format: UCHAR\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "2 x 2", dat);
-    write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 -1 1\n"
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "2 x 2", dat);
+    test_write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 -1 1\n"
                     "Format: UCHAR\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "1 -1 1", dat);
-    write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 1 1\n"
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "1 -1 1", dat);
+    test_write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 2\nSliceThickness: 1 1 1\n"
                     "Format: UCHAR\nObjectModel: RGBA\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "RGBA", dat);
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT, "RGBA", dat);
     /* A raw file of the wrong size is reported with both sizes, under the .dat loader's name. */
-    write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 3\nSliceThickness: 1 1 1\n"
+    test_write_text(dat, "ObjectFileName: bad_data.raw\nResolution: 2 2 3\nSliceThickness: 1 1 1\n"
                     "Format: UCHAR\n");
-    assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT,
+    test_assert_failed(ctx, umbra_volume_load_dat(ctx, dat, &vol), UMBRA_ERROR_FORMAT,
                   "umbra_volume_load_dat", "holds 8 bytes, expected 12");
     assert_null(vol);
     remove(dat);
@@ -747,7 +682,7 @@ static void test_tf_file_parses_points(void **state)
                                      {1.0f, 0.75f, 0.5f, 1.0f},
                                      {1.0f, 1.0f, 0.75f, 1.0f}};
     size_t i, c;
-    write_text(tmp_path(path, "points.tf"), "# a comment line\r\n"
+    test_write_text(tmp_path(path, "points.tf"), "# a comment line\r\n"
                                             "\r\n"
                                             "   resolution 5   # trailing comment\r\n"
                                             "0.0   0 0 0 0\r\n"
@@ -774,7 +709,7 @@ static void test_tf_file_default_resolution_is_256(void **state)
     umbra_transfer_function tf = NULL;
     const float *table;
     uint32_t i;
-    write_text(tmp_path(path, "one.tf"), "0.5 0.2 0.4 0.6 0.8\n");
+    test_write_text(tmp_path(path, "one.tf"), "0.5 0.2 0.4 0.6 0.8\n");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     assert_int_equal(umbra_transfer_function_size(tf), 256);
     table = umbra_transfer_function_data(tf);
@@ -791,27 +726,27 @@ static void test_tf_file_bad_line_names_line_number(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN], needle[PATH_MAX_LEN + 8];
     umbra_transfer_function tf = (umbra_transfer_function)state;
-    write_text(tmp_path(path, "short_line.tf"), "# header\n"
+    test_write_text(tmp_path(path, "short_line.tf"), "# header\n"
                                                 "0 0 0 0 0\n"
                                                 "\n"
                                                 "0.5 1 1\n"
                                                 "1 1 1 1 1\n");
     snprintf(needle, sizeof needle, "%s:4:", path);
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "\"0.5 1 1\"");
     assert_null(tf);
 
-    write_text(path, "0 0 0 0 0\n0.5 1 one 1 1\n");
+    test_write_text(path, "0 0 0 0 0\n0.5 1 one 1 1\n");
     snprintf(needle, sizeof needle, "%s:2:", path);
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "green \"one\" is not a number");
 
-    write_text(path, "0 0 0 0 0\n0.5 1 1 1 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n0.5 1 1 1 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "6 fields");
 
-    write_text(path, "0 0 0 0 0\n0.5 1 1 1 1x\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n0.5 1 1 1 1x\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "\"1x\"");
     remove(path);
 }
@@ -823,14 +758,14 @@ static void test_tf_file_nan_rejected(void **state)
     umbra_transfer_function tf = NULL;
     tmp_path(path, "nan.tf");
     snprintf(needle, sizeof needle, "%s:2:", path);
-    write_text(path, "0 0 0 0 0\n0.5 1 nan 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n0.5 1 nan 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "green \"nan\" is not a finite number");
-    write_text(path, "0 0 0 0 0\ninf 1 1 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\ninf 1 1 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "value \"inf\" is not a finite number");
-    write_text(path, "0 0 0 0 0\n1 1 1 1 1e99\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n1 1 1 1 1e99\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "alpha \"1e99\" is not in [0,1]");
     assert_null(tf);
     remove(path);
@@ -843,18 +778,18 @@ static void test_tf_file_out_of_range_or_descending_rejected(void **state)
     umbra_transfer_function tf = NULL;
     tmp_path(path, "range.tf");
     snprintf(needle, sizeof needle, "%s:2:", path);
-    write_text(path, "0 0 0 0 0\n0.5 1.5 1 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n0.5 1.5 1 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "red \"1.5\" is not in [0,1]");
-    write_text(path, "0 0 0 0 0\n-0.25 1 1 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\n-0.25 1 1 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "value \"-0.25\"");
-    write_text(path, "0.6 0 0 0 0\n0.5 1 1 1 1\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0.6 0 0 0 0\n0.5 1 1 1 1\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "ascending");
 
     /* Equal values are a step, not an error. */
-    write_text(path, "0 0 0 0 0\n0.5 0 0 0 0\n0.5 1 1 1 1\n1 1 1 1 1\n");
+    test_write_text(path, "0 0 0 0 0\n0.5 0 0 0 0\n0.5 1 1 1 1\n1 1 1 1 1\n");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     umbra_transfer_function_release(tf);
     remove(path);
@@ -867,24 +802,24 @@ static void test_tf_file_bad_resolution_rejected(void **state)
     umbra_transfer_function tf = NULL;
     tmp_path(path, "res.tf");
     snprintf(needle, sizeof needle, "%s:1:", path);
-    write_text(path, "resolution 1\n0 0 0 0 0\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "resolution 1\n0 0 0 0 0\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "resolution 1");
-    write_text(path, "resolution 65537\n0 0 0 0 0\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "resolution 65537\n0 0 0 0 0\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "2..65536");
-    write_text(path, "resolution 12.5\n0 0 0 0 0\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "resolution 12.5\n0 0 0 0 0\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "12.5");
-    write_text(path, "resolution\n0 0 0 0 0\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "resolution\n0 0 0 0 0\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   NULL);
     snprintf(needle, sizeof needle, "%s:2:", path);
-    write_text(path, "0 0 0 0 0\nresolution 16\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
+    test_write_text(path, "0 0 0 0 0\nresolution 16\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, needle,
                   "before the first control point");
 
-    write_text(path, "resolution 65536\n0 0 0 0 0\n");
+    test_write_text(path, "resolution 65536\n0 0 0 0 0\n");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     assert_int_equal(umbra_transfer_function_size(tf), 65536);
     umbra_transfer_function_release(tf);
@@ -900,7 +835,7 @@ static void test_tf_file_range_in_data_units(void **state)
     float range[2];
     static const float alpha[5] = {0.0f, 0.0f, 0.5f, 1.0f, 1.0f}; /* at 0, 100, .., 400 */
     uint32_t i;
-    write_text(tmp_path(path, "hu.tf"), "# Hounsfield-like units\n"
+    test_write_text(tmp_path(path, "hu.tf"), "# Hounsfield-like units\n"
                                         "range 0 400   # data units\n"
                                         "resolution 5\n"
                                         "100 0 0 0 0\n"
@@ -916,7 +851,7 @@ static void test_tf_file_range_in_data_units(void **state)
     umbra_transfer_function_release(tf);
     tf = NULL;
     /* Without the line there is no range. */
-    write_text(path, "0 0 0 0 0\n1 1 1 1 1\n");
+    test_write_text(path, "0 0 0 0 0\n1 1 1 1 1\n");
     assert_int_equal(umbra_transfer_function_load(ctx, path, &tf), UMBRA_SUCCESS);
     assert_int_equal(umbra_transfer_function_get_range(tf, range), 0);
     umbra_transfer_function_release(tf);
@@ -950,9 +885,9 @@ static void test_tf_file_bad_range_rejected(void **state)
     size_t i;
     tmp_path(path, "bad_range.tf");
     for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        write_text(path, cases[i].text);
+        test_write_text(path, cases[i].text);
         snprintf(needle, sizeof needle, "%s:%d:", path, cases[i].line);
-        assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
+        test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT,
                       needle, cases[i].message);
         assert_null(tf);
     }
@@ -964,11 +899,11 @@ static void test_tf_file_without_points_rejected(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     umbra_transfer_function tf = NULL;
-    write_text(tmp_path(path, "empty.tf"), "# only a comment\nresolution 16\n\n");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, path,
+    test_write_text(tmp_path(path, "empty.tf"), "# only a comment\nresolution 16\n\n");
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, path,
                   "no control points");
-    write_bytes(path, "0 0 0 0 0\n\0\n", 12);
-    assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, path,
+    test_write_bytes(path, "0 0 0 0 0\n\0\n", 12);
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, path, &tf), UMBRA_ERROR_FORMAT, path,
                   "NUL");
     assert_null(tf);
     remove(path);
@@ -979,9 +914,9 @@ static void test_tf_file_missing_is_io_error(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     umbra_transfer_function tf = NULL;
-    assert_failed(ctx, umbra_transfer_function_load(ctx, tmp_path(path, "absent.tf"), &tf),
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, tmp_path(path, "absent.tf"), &tf),
                   UMBRA_ERROR_IO, path, "umbra_transfer_function_load");
-    assert_failed(ctx, umbra_transfer_function_load(ctx, NULL, &tf),
+    test_assert_failed(ctx, umbra_transfer_function_load(ctx, NULL, &tf),
                   UMBRA_ERROR_INVALID_ARGUMENT, "path", NULL);
     assert_null(tf);
 }
@@ -1073,7 +1008,7 @@ static void write_png_by_hand(const char *path, uint32_t w, uint32_t h, int colo
     pos += png_chunk(file + pos, "IHDR", ihdr, sizeof ihdr);
     pos += png_chunk(file + pos, "IDAT", zlib, z);
     pos += png_chunk(file + pos, "IEND", NULL, 0);
-    write_bytes(path, file, pos);
+    test_write_bytes(path, file, pos);
 }
 
 static void test_image_png_read_decodes_srgb_and_premultiplies(void **state)
@@ -1245,13 +1180,13 @@ static void test_image_unknown_extension(void **state)
     const float px[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     uint32_t w = 7, h = 7;
     float *out = (float *)state;
-    assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "picture.tiff"), 1, 1, px),
+    test_assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "picture.tiff"), 1, 1, px),
                   UMBRA_ERROR_INVALID_ARGUMENT, "\"tiff\"", path);
     assert_true(test_message_contains(ctx, ".png"));
     assert_true(test_message_contains(ctx, ".exr"));
-    assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "no_extension"), 1, 1, px),
+    test_assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "no_extension"), 1, 1, px),
                   UMBRA_ERROR_INVALID_ARGUMENT, "no_extension", NULL);
-    assert_failed(ctx, umbra_image_read(ctx, tmp_path(path, "picture.jpg"), &w, &h, &out),
+    test_assert_failed(ctx, umbra_image_read(ctx, tmp_path(path, "picture.jpg"), &w, &h, &out),
                   UMBRA_ERROR_INVALID_ARGUMENT, "\"jpg\"", path);
     assert_null(out);
     assert_int_equal(w, 0);
@@ -1266,17 +1201,17 @@ static void test_image_invalid_arguments(void **state)
     uint32_t w, h;
     float *out = NULL;
     tmp_path(path, "invalid.png");
-    assert_failed(ctx, umbra_image_write(ctx, path, 0, 1, px), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_write(ctx, path, 0, 1, px), UMBRA_ERROR_INVALID_ARGUMENT,
                   "0 x 1", NULL);
-    assert_failed(ctx, umbra_image_write(ctx, path, 1, 65537, px), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_write(ctx, path, 1, 65537, px), UMBRA_ERROR_INVALID_ARGUMENT,
                   "1 x 65537", NULL);
-    assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, NULL), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, NULL), UMBRA_ERROR_INVALID_ARGUMENT,
                   "rgba is NULL", NULL);
-    assert_failed(ctx, umbra_image_write(ctx, NULL, 1, 1, px), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_write(ctx, NULL, 1, 1, px), UMBRA_ERROR_INVALID_ARGUMENT,
                   "path is NULL", NULL);
-    assert_failed(ctx, umbra_image_read(ctx, path, &w, NULL, &out), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_read(ctx, path, &w, NULL, &out), UMBRA_ERROR_INVALID_ARGUMENT,
                   "umbra_image_read", NULL);
-    assert_failed(ctx, umbra_image_read(ctx, NULL, &w, &h, &out), UMBRA_ERROR_INVALID_ARGUMENT,
+    test_assert_failed(ctx, umbra_image_read(ctx, NULL, &w, &h, &out), UMBRA_ERROR_INVALID_ARGUMENT,
                   "path is NULL", NULL);
 }
 
@@ -1286,7 +1221,7 @@ static void test_image_read_missing_is_io_error(void **state)
     char path[PATH_MAX_LEN];
     uint32_t w, h;
     float *out = NULL;
-    assert_failed(ctx, umbra_image_read(ctx, tmp_path(path, "absent.png"), &w, &h, &out),
+    test_assert_failed(ctx, umbra_image_read(ctx, tmp_path(path, "absent.png"), &w, &h, &out),
                   UMBRA_ERROR_IO, path, "No such file");
     assert_null(out);
 }
@@ -1297,12 +1232,12 @@ static void test_image_read_garbage_is_format_error(void **state)
     char path[PATH_MAX_LEN];
     uint32_t w, h;
     float *out = NULL;
-    write_text(tmp_path(path, "garbage.png"), "not a PNG at all, just text\n");
-    assert_failed(ctx, umbra_image_read(ctx, path, &w, &h, &out), UMBRA_ERROR_FORMAT, path,
+    test_write_text(tmp_path(path, "garbage.png"), "not a PNG at all, just text\n");
+    test_assert_failed(ctx, umbra_image_read(ctx, path, &w, &h, &out), UMBRA_ERROR_FORMAT, path,
                   "umbra_image_read");
     assert_null(out);
-    write_text(tmp_path(path, "garbage.exr"), "not an EXR either\n");
-    assert_failed(ctx, umbra_image_read(ctx, path, &w, &h, &out), UMBRA_ERROR_FORMAT, path,
+    test_write_text(tmp_path(path, "garbage.exr"), "not an EXR either\n");
+    test_assert_failed(ctx, umbra_image_read(ctx, path, &w, &h, &out), UMBRA_ERROR_FORMAT, path,
                   NULL);
     remove(path);
     tmp_path(path, "garbage.png");
@@ -1314,16 +1249,16 @@ static void test_image_write_to_missing_directory_is_io_error(void **state)
     umbra_context ctx = *state;
     char path[PATH_MAX_LEN];
     const float px[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-    assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "no_dir/out.png"), 1, 1, px),
+    test_assert_failed(ctx, umbra_image_write(ctx, tmp_path(path, "no_dir/out.png"), 1, 1, px),
                   UMBRA_ERROR_IO, path, "umbra_image_write");
-    assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, px), UMBRA_ERROR_IO, path, NULL);
+    test_assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, px), UMBRA_ERROR_IO, path, NULL);
     tmp_path(path, "no_dir/out.exr");
-    assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, px), UMBRA_ERROR_IO, path, NULL);
+    test_assert_failed(ctx, umbra_image_write(ctx, path, 1, 1, px), UMBRA_ERROR_IO, path, NULL);
 }
 
 /* ---- main ------------------------------------------------------------------------------- */
 
-#define IO_TEST(t) cmocka_unit_test_setup_teardown(t, setup_context, teardown_context)
+#define IO_TEST(t) cmocka_unit_test_setup_teardown(t, test_group_setup, test_group_teardown)
 
 int main(void)
 {

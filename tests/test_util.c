@@ -44,6 +44,71 @@ const char *test_tmpdir(void)
     return tmpdir;
 }
 
+void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
+                        const char *needle, const char *needle2)
+{
+    static const uint8_t voxels[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    umbra_volume_desc desc;
+    umbra_volume vol = NULL;
+    if (got != expected || !test_message_contains(ctx, needle) ||
+        (needle2 && !test_message_contains(ctx, needle2))) {
+        print_message("got %s, expected %s; message \"%s\"; looked for \"%s\" and \"%s\"\n",
+                      umbra_status_to_string(got), umbra_status_to_string(expected),
+                      umbra_context_last_message(ctx), needle, needle2 ? needle2 : "");
+    }
+    assert_int_equal(got, expected);
+    assert_true(test_message_contains(ctx, needle));
+    if (needle2)
+        assert_true(test_message_contains(ctx, needle2));
+    assert_int_equal(umbra_context_take_error(ctx, NULL), expected);
+    umbra_volume_desc_init(&desc);
+    desc.data = voxels;
+    desc.type = UMBRA_UINT8;
+    desc.dims[0] = desc.dims[1] = desc.dims[2] = 2;
+    assert_int_equal(umbra_volume_create(ctx, &desc, &vol), UMBRA_SUCCESS);
+    assert_non_null(vol);
+    umbra_volume_release(vol);
+    assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_SUCCESS);
+}
+
+const char *test_tmp_path(char *buf, size_t size, const char *name)
+{
+    int n = snprintf(buf, size, "%s/%s", test_tmpdir(), name);
+    assert_true(n > 0 && (size_t)n < size);
+    return buf;
+}
+
+void test_write_bytes(const char *path, const void *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, size, f), size);
+    assert_int_equal(fclose(f), 0);
+}
+
+void test_write_text(const char *path, const char *text)
+{
+    test_write_bytes(path, text, strlen(text));
+}
+
+void *test_read_bytes(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    long n;
+    void *buf;
+    assert_non_null(f);
+    assert_int_equal(fseek(f, 0, SEEK_END), 0);
+    n = ftell(f);
+    assert_true(n > 0);
+    rewind(f);
+    buf = malloc((size_t)n);
+    assert_non_null(buf);
+    assert_int_equal(fread(buf, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *size = (size_t)n;
+    return buf;
+}
+
 int test_message_contains(umbra_context ctx, const char *needle)
 {
     const char *m = umbra_context_last_message(ctx);

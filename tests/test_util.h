@@ -28,6 +28,19 @@ const char *test_tmpdir(void);
 /* Nonzero if the context's last error message contains needle. */
 int test_message_contains(umbra_context ctx, const char *needle);
 
+/* A call failed with status expected and a message containing needle (and needle2 if not NULL);
+ * the sticky error held that status, and the context still creates a small volume. */
+void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
+                        const char *needle, const char *needle2);
+
+/* buf (size bytes) = test_tmpdir()/name; fails the test if it does not fit. Returns buf. */
+const char *test_tmp_path(char *buf, size_t size, const char *name);
+/* Writes size bytes (or a string) to path, failing the test on any error. */
+void test_write_bytes(const char *path, const void *data, size_t size);
+void test_write_text(const char *path, const char *text);
+/* Reads a whole non-empty file into a malloc'ed buffer (the caller frees it). */
+void *test_read_bytes(const char *path, size_t *size);
+
 /* A float32 volume of nx x ny x nz voxels (x fastest) copied from data, unit spacing, value
  * range [0, 1]. */
 umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
