@@ -483,28 +483,6 @@ static void nim_write(nifti_image *nim, const char *path)
     nifti_image_free(nim);
 }
 
-static float *read_voxels(umbra_volume vol)
-{
-    const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
-    float *out = malloc(count * sizeof *out);
-    cl_int err;
-    assert_non_null(out);
-    if (vol->data) {
-        err = clEnqueueReadBuffer(vol->ctx->queue, vol->data, CL_TRUE, 0, count * sizeof *out, out,
-                                  0, NULL, NULL);
-    } else {
-        size_t origin[3] = {0, 0, 0};
-        size_t region[3];
-        region[0] = vol->dims[0];
-        region[1] = vol->dims[1];
-        region[2] = vol->dims[2];
-        err = clEnqueueReadImage(vol->ctx->queue, vol->image, CL_TRUE, origin, region, 0, 0, out,
-                                 0, NULL, NULL);
-    }
-    assert_int_equal(err, CL_SUCCESS);
-    return out;
-}
-
 /* vol has dims, spacing, range [lo, hi] and voxels (want[i] - lo) / (hi - lo). */
 static void assert_volume(umbra_volume vol, const uint32_t dims[3], const float spacing[3],
                           const double *want, double lo, double hi)
@@ -519,7 +497,7 @@ static void assert_volume(umbra_volume vol, const uint32_t dims[3], const float 
     }
     assert_float_equal(info.value_min, lo, 1e-3);
     assert_float_equal(info.value_max, hi, 1e-3);
-    vox = read_voxels(vol);
+    vox = test_read_voxels(vol);
     for (i = 0; i < count; ++i) {
         double w = (want[i] - lo) / (hi - lo);
         if (fabs(vox[i] - w) > 1e-6) {

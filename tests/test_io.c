@@ -36,30 +36,6 @@ static const char *tmp_path(char *buf, const char *name)
     return test_tmp_path(buf, PATH_MAX_LEN, name);
 }
 
-/* Reads a volume's normalised voxels back from the device. */
-static float *read_voxels(umbra_volume vol)
-{
-    const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
-    float *out = malloc(count * sizeof *out);
-    cl_int err;
-    assert_non_null(out);
-    if (vol->data) {
-        err = clEnqueueReadBuffer(vol->ctx->queue, vol->data, CL_TRUE, 0, count * sizeof *out, out,
-                                  0, NULL, NULL);
-    } else {
-        size_t origin[3] = {0, 0, 0};
-        size_t region[3];
-        region[0] = vol->dims[0];
-        region[1] = vol->dims[1];
-        region[2] = vol->dims[2];
-        assert_non_null(vol->image);
-        err = clEnqueueReadImage(vol->ctx->queue, vol->image, CL_TRUE, origin, region, 0, 0, out,
-                                 0, NULL, NULL);
-    }
-    assert_int_equal(err, CL_SUCCESS);
-    return out;
-}
-
 /* The volume has these dims and spacing, the data's range [lo, hi], and voxels equal to
  * (raw - lo) / (hi - lo) within 1e-6. */
 static void assert_volume(umbra_volume vol, uint32_t nx, uint32_t ny, uint32_t nz,
@@ -79,7 +55,7 @@ static void assert_volume(umbra_volume vol, uint32_t nx, uint32_t ny, uint32_t n
     }
     assert_float_equal(info.value_min, lo, 1e-6);
     assert_float_equal(info.value_max, hi, 1e-6);
-    vox = read_voxels(vol);
+    vox = test_read_voxels(vol);
     for (i = 0; i < count; ++i) {
         double want = (raw[i] - lo) / (hi - lo);
         if (fabs(vox[i] - want) > 1e-6) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_util.c: see test_util.h. */
 #define _POSIX_C_SOURCE 200809L
+#include "internal.h" /* test_read_voxels reads the volume's device copy */
 #include "test_util.h"
 
 #include <stdio.h>
@@ -69,6 +70,29 @@ void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expect
     assert_non_null(vol);
     umbra_volume_release(vol);
     assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_SUCCESS);
+}
+
+float *test_read_voxels(umbra_volume vol)
+{
+    const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
+    float *out = malloc(count * sizeof *out);
+    cl_int err;
+    assert_non_null(out);
+    if (vol->data) {
+        err = clEnqueueReadBuffer(vol->ctx->queue, vol->data, CL_TRUE, 0, count * sizeof *out, out,
+                                  0, NULL, NULL);
+    } else {
+        size_t origin[3] = {0, 0, 0};
+        size_t region[3];
+        region[0] = vol->dims[0];
+        region[1] = vol->dims[1];
+        region[2] = vol->dims[2];
+        assert_non_null(vol->image);
+        err = clEnqueueReadImage(vol->ctx->queue, vol->image, CL_TRUE, origin, region, 0, 0, out,
+                                 0, NULL, NULL);
+    }
+    assert_int_equal(err, CL_SUCCESS);
+    return out;
 }
 
 const char *test_tmp_path(char *buf, size_t size, const char *name)

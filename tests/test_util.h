@@ -33,6 +33,9 @@ int test_message_contains(umbra_context ctx, const char *needle);
 void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
                         const char *needle, const char *needle2);
 
+/* A volume's normalised voxels read back from the device (malloc'ed; the caller frees them). */
+float *test_read_voxels(umbra_volume vol);
+
 /* buf (size bytes) = test_tmpdir()/name; fails the test if it does not fit. Returns buf. */
 const char *test_tmp_path(char *buf, size_t size, const char *name);
 /* Writes size bytes (or a string) to path, failing the test on any error. */
