@@ -9,7 +9,7 @@
  *   volume builtin NAME [RES]   a built-in scene (umbra/scene.h) at RES^3 voxels (0: its default)
  *   volume FILE                 a .nhdr/.nrrd/.dat file: absolute, or relative to the data
  *                               directory ($UMBRA_DATA_DIR, else <source>/../shared/data/volumes)
- *   tf FILE | builtin           transfer function (text format of host/tf_file.c), relative to the
+ *   tf FILE | builtin           transfer function (text format of io/tf_file.c), relative to the
  *                               scene file's directory; builtin (the default for built-in volumes)
  *                               keeps the built-in scene's own
  *   light_tf FILE               optional separate transfer function for the light pass

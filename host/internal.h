@@ -60,8 +60,8 @@ const char *umbra__cl_error_name(cl_int err);
 
 typedef struct umbra__program umbra__program;
 
-/* The object structs use C11 atomics, which C++17 lacks: C++ files (host/image.cpp) see only
- * the functions. */
+/* The object structs use C11 atomics, which C++17 lacks: a C++ file including this header would
+ * see only the functions (none does today; umbra_io's image.cpp uses the public API). */
 #ifndef __cplusplus
 /* Threads: a context may be shared by objects used on different threads (include/umbra/
  * context.h), so its reference count and ids are atomic and mutexes guard what they share: the

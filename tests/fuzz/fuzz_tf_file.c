@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_tf_file.c: libFuzzer harness for the transfer-function text format
- * (umbra_transfer_function_load, host/tf_file.c): any bytes must give a table or a status with a
+ * (umbra_transfer_function_load, io/tf_file.c): any bytes must give a table or a status with a
  * message, never a crash, hang, leak or sanitizer report. */
 #define _POSIX_C_SOURCE 200809L
 
