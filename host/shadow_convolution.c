@@ -331,6 +331,8 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
             r->stats.shadow_rebuilt = 1;
     }
     cl_uint next = 0;
+    /* Declared before the first UMBRA_CL: the fail path releases them. */
+    cl_event pending = NULL, mark = NULL;
     if ((st = umbra__bind_common(r, s->slice, &next)) != UMBRA_SUCCESS)
         return st;
     const cl_uint base = next;
@@ -369,7 +371,6 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         double g = budget / (per_slice > 1.0 ? per_slice : 1.0);
         group = g < 1.0 ? 1u : g > (double)n ? (n ? n : 1u) : (uint32_t)g;
     }
-    cl_event pending = NULL, mark = NULL;
     for (uint32_t i = 0; i < n; ++i) {
         if (group != UINT32_MAX && i > 0 && i % group == 0) {
             UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, &mark));
