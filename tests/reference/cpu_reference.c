@@ -687,15 +687,19 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
                 if (c[3] > 0.0f) {
                     /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
-                     * a segment of opacity a (kernels/raycast.cl, shadow_point). */
-                    float a = c[3], m;
-                    if (!(a < 1.0f))
-                        m = 0.0f;
-                    else if (a < 1e-3f)
-                        m = 0.5f + log1pf(-a) / 12.0f;
-                    else
-                        m = -1.0f / log1pf(-a) - (1.0f - a) / a;
-                    v3 sf = shadow_factor(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
+                     * a segment of opacity a (kernels/raycast.cl, shadow_point); only where
+                     * there is a shadow to look up, as the kernel compiled without one does. */
+                    v3 sf = mk(1, 1, 1);
+                    if (P->s->shadow == UMBRA_SHADOW_REFERENCE) {
+                        float a = c[3], m;
+                        if (!(a < 1.0f))
+                            m = 0.0f;
+                        else if (a < 1e-3f)
+                            m = 0.5f + log1pf(-a) / 12.0f;
+                        else
+                            m = -1.0f / log1pf(-a) - (1.0f - a) / a;
+                        sf = shadow(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
+                    }
                     v3 light = vmul(from(s->light.color), sf);
                     v3 amb = from(o->ambient);
                     v3 lit;
