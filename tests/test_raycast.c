@@ -73,25 +73,6 @@ static double next_uniform(uint32_t *state)
     return (double)(x >> 8) / 16777216.0;
 }
 
-/* Length of the part of the segment p + t dir, t in [0, t_max], that lies in the box
- * [-half, half], in double precision (dir unit). */
-static double path_in_box(const double p[3], const double dir[3], const double half[3],
-                          double t_max)
-{
-    double lo = 0.0, hi = t_max;
-    for (int a = 0; a < 3; ++a) {
-        if (dir[a] == 0.0) {
-            if (p[a] < -half[a] || p[a] > half[a])
-                return 0.0;
-            continue;
-        }
-        double ta = (-half[a] - p[a]) / dir[a], tb = (half[a] - p[a]) / dir[a];
-        lo = fmax(lo, fmin(ta, tb));
-        hi = fmin(hi, fmax(ta, tb));
-    }
-    return hi > lo ? hi - lo : 0.0;
-}
-
 /* Unit direction from p toward the light and the distance to it (infinite for directional). */
 static void toward_light(const umbra_light *l, const double p[3], double dir[3], double *dist)
 {
@@ -156,7 +137,7 @@ static double check_slab(umbra_renderer r, const double half[3], double voxel, d
     for (int i = 0; i < SLAB_POINTS; ++i) {
         double p[3] = {pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]}, dir[3], dist;
         toward_light(light, p, dir, &dist);
-        double d = path_in_box(p, dir, half, dist);
+        double d = test_path_in_box(p, dir, half, dist);
         for (int c = 0; c < 3; ++c) {
             double want = t ? model_transmittance(a, step, d / (step * voxel), t[c])
                             : exp(log(1.0 - a) * d / voxel);
@@ -293,7 +274,7 @@ static void test_reference_extreme_opacity_long_path(void **state)
             for (int i = 0; i < N; ++i) {
                 double p[3] = {pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]}, dir[3], dist;
                 toward_light(&lights[l], p, dir, &dist);
-                double d = path_in_box(p, dir, half, dist);
+                double d = test_path_in_box(p, dir, half, dist);
                 double want = exp(d * log1p(-a));
                 double bound = a > 0.5 ? fmax(1e-3 * want, 1.5e-6) : 1e-2 * (1.0 - want) + 2e-7;
                 for (int c = 0; c < 3; ++c) {

@@ -4,6 +4,7 @@
 #include "internal.h" /* test_read_voxels reads the volume's device copy */
 #include "test_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,6 +71,23 @@ void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expect
     assert_non_null(vol);
     umbra_volume_release(vol);
     assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_SUCCESS);
+}
+
+double test_path_in_box(const double p[3], const double dir[3], const double half[3],
+                        double t_max)
+{
+    double lo = 0.0, hi = t_max;
+    for (int a = 0; a < 3; ++a) {
+        if (dir[a] == 0.0) {
+            if (p[a] < -half[a] || p[a] > half[a])
+                return 0.0;
+            continue;
+        }
+        double ta = (-half[a] - p[a]) / dir[a], tb = (half[a] - p[a]) / dir[a];
+        lo = fmax(lo, fmin(ta, tb));
+        hi = fmin(hi, fmax(ta, tb));
+    }
+    return hi > lo ? hi - lo : 0.0;
 }
 
 float *test_read_voxels(umbra_volume vol)

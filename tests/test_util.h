@@ -33,6 +33,11 @@ int test_message_contains(umbra_context ctx, const char *needle);
 void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expected,
                         const char *needle, const char *needle2);
 
+/* Length of the part of the segment p + t dir, t in [0, t_max], inside the box [-half, half], in
+ * double precision (dir unit): the analytic path for exp(-sigma d) checks. */
+double test_path_in_box(const double p[3], const double dir[3], const double half[3],
+                        double t_max);
+
 /* A volume's normalised voxels read back from the device (malloc'ed; the caller frees them). */
 float *test_read_voxels(umbra_volume vol);
 

@@ -240,24 +240,6 @@ static void test_turned_volume_renders_as_permuted_copy(void **state)
 
 /* ---- query_shadow in a rotated, translated box ------------------------------------------------- */
 
-/* Length of the part of p + s dir, s in [0, s_max], inside the box [-half, half] (double). */
-static double path_in_box(const double p[3], const double dir[3], const double half[3],
-                          double s_max)
-{
-    double lo = 0.0, hi = s_max;
-    for (int a = 0; a < 3; ++a) {
-        if (dir[a] == 0.0) {
-            if (p[a] < -half[a] || p[a] > half[a])
-                return 0.0;
-            continue;
-        }
-        double ta = (-half[a] - p[a]) / dir[a], tb = (half[a] - p[a]) / dir[a];
-        lo = fmax(lo, fmin(ta, tb));
-        hi = fmin(hi, fmax(ta, tb));
-    }
-    return hi > lo ? hi - lo : 0.0;
-}
-
 static double next_uniform(uint32_t *state)
 {
     uint32_t x = *state;
@@ -355,7 +337,7 @@ static void test_query_shadow_in_rotated_box_matches_exp(void **state)
                 dist = len;
             for (int a2 = 0; a2 < 3; ++a2)
                 dl[a2] = (R[a2][0] * dw[0] + R[a2][1] * dw[1] + R[a2][2] * dw[2]) / len;
-            double d = path_in_box(local[i], dl, half, dist);
+            double d = test_path_in_box(local[i], dl, half, dist);
             double want = exp(log(1.0 - a) * d / voxel);
             for (int c = 0; c < 3; ++c) {
                 double err = fabs(rgb[3 * i + c] - want);
