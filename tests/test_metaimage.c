@@ -7,7 +7,8 @@
  * axis directions are compared with the header's numbers. Broken files (short or long data,
  * bad or huge sizes, unknown types, missing data files, several channels, a hostile NDims, corrupt
  * compression) are refused with a status and a message naming the value, and leave the context
- * usable. The last test runs umbra-render (./umbra-render in ctest's working directory, or
+ * usable. Files written by ITK's own MetaIO (shipped in tests/data/metaimage) check the reader
+ * against an independent writer. The last test runs umbra-render (./umbra-render in ctest's working directory, or
  * $UMBRA_RENDER) on an .mha file. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -316,6 +317,44 @@ static void test_metaimage_compressed_and_header_size(void **state)
     load_and_check(ctx, path, dims, unit, want, 0.0, 3106.0);
 }
 
+/* Files ITK's own MetaIO wrote (tests/data/metaimage/make_files.cpp): int16 compressed in an .mha
+ * and raw in an .mhd + .raw pair with an offset and a permuting matrix, float32 in .mhd + .zraw,
+ * uint8 in an .mha; the values are the generator's formulas. */
+static void test_metaimage_itk_written_files(void **state)
+{
+    umbra_context ctx = *state;
+    static const uint32_t dims[3] = {5, 4, 3};
+    const float spacing[3] = {0.7f, 1.3f, 2.1f};
+    static const char *const names[4] = {"itk_short_z.mha", "itk_short.mhd", "itk_float_z.mhd",
+                                         "itk_u8.mha"};
+    const float offset[3] = {12.5f, -30.0f, 4.0f}, dirs[9] = {0, 0, 1, 1, 0, 0, 0, 1, 0};
+    char path[PATH_MAX_LEN];
+    double want[60];
+    int f, i;
+    for (f = 0; f < 4; ++f) {
+        umbra_volume vol = NULL;
+        umbra_volume_info info;
+        double lo = 1e30, hi = -1e30;
+        for (i = 0; i < 60; ++i) {
+            want[i] = f < 2 ? -1000.0 + 37.0 * i : f == 2 ? 0.25 * i - 3.0 : (double)(i * 7 % 256);
+            lo = want[i] < lo ? want[i] : lo;
+            hi = want[i] > hi ? want[i] : hi;
+        }
+        snprintf(path, sizeof path, "%s/metaimage/%s", UMBRA_TEST_DATA_DIR, names[f]);
+        load_and_check(ctx, path, dims, spacing, want, lo, hi);
+        assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
+        assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
+        assert_int_equal(info.transform_given, 1); /* ITK always writes Offset and the matrix */
+        for (i = 0; i < 3; ++i) {
+            assert_float_equal(info.origin[i], f < 2 ? offset[i] : 0.0f, 1e-6);
+        }
+        for (i = 0; i < 9; ++i) {
+            assert_float_equal(info.directions[i], f < 2 ? dirs[i] : (i % 4 == 0), 1e-6);
+        }
+        umbra_volume_release(vol);
+    }
+}
+
 /* ---- what is refused --------------------------------------------------------------------------- */
 
 #define HEAD3 "ObjectType = Image\nNDims = 3\n"
@@ -555,6 +594,7 @@ int main(void)
         T(test_metaimage_types),
         T(test_metaimage_world),
         T(test_metaimage_compressed_and_header_size),
+        T(test_metaimage_itk_written_files),
         T(test_metaimage_broken_files_refused),
         T(test_cli_renders_mha),
 #undef T
