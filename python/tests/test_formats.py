@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Issue 13's acceptance through Python: a NIfTI volume written with nibabel (and a MetaImage written
-here) and a ParaView preset
-rendered with technique cssm from Python and by umbra-render --volume x.nii.gz --tf preset.json
-give the same pixels. Also: transfer-function data ranges and ParaView presets from Python."""
+"""Issue 13's acceptance through Python: a NIfTI volume written with nibabel (and a MetaImage
+written here) and a ParaView preset rendered with technique cssm from Python and by umbra-render
+--volume x.nii.gz --tf preset.json (x.mha) give the same pixels. Also: transfer-function data
+ranges and ParaView presets from Python."""
 
 import json
 import os
