@@ -114,9 +114,10 @@ static int is_blank(char c)
 }
 
 /* Splits the header in text (n bytes, NUL-terminated by the caller at n) into *h, cutting values
- * in place. The header ends with the ElementDataFile line. */
+ * in place. The header ends with the ElementDataFile line; whole says text is the whole file, whose
+ * last line may then lack its newline (an .mhd written by hand). */
 static umbra_status header_parse(umbra_context ctx, const char *func, const char *path, char *text,
-                                 size_t n, met_header *h)
+                                 size_t n, int whole, met_header *h)
 {
     size_t pos = 0;
     unsigned line_no = 0;
@@ -128,6 +129,9 @@ static umbra_status header_parse(umbra_context ctx, const char *func, const char
         int slot = -1;
         ++line_no;
         end = memchr(line, '\n', n - pos);
+        if (!end && whole) {
+            end = text + n; /* the NUL the caller put there */
+        }
         if (!end) {
             return umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                                "%s: \"%s\": the header has no ElementDataFile line within its "
@@ -142,7 +146,7 @@ static umbra_status header_parse(umbra_context ctx, const char *func, const char
                                func, path, line_no);
         }
         *end = '\0';
-        pos += len + 1;
+        pos += len + (pos + len < n); /* past the newline, if there is one */
         while (is_blank(*line)) {
             ++line;
         }
@@ -407,7 +411,7 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
         goto fail;
     }
     text[head_n] = '\0';
-    st = header_parse(ctx, func, path, text, head_n, &h);
+    st = header_parse(ctx, func, path, text, head_n, head_n == file_size, &h);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }

@@ -133,8 +133,9 @@ static void test_metaimage_uint8_mha(void **state)
     umbra_volume_release(vol);
 }
 
-/* Element types: big-endian int16 in a .mhd + .raw pair, float32, int8 (int16), uint32 and
- * float64 (float32); ElementSize stands in for a missing ElementSpacing; CRLF line ends. */
+/* Element types: big-endian int16 in a .mhd + .raw pair (CRLF line ends, no newline at the end),
+ * float32, int8 (int16), uint32 and float64 (float32); ElementSize stands in for a missing
+ * ElementSpacing. */
 static void test_metaimage_types(void **state)
 {
     umbra_context ctx = *state;
@@ -158,8 +159,8 @@ static void test_metaimage_types(void **state)
         write_mha(tmp_path(path, "i16.mhd"),
                   "ObjectType = Image\r\nNDims = 3\r\nDimSize = 2 2 2\r\n"
                   "ElementByteOrderMSB = True\r\nElementType = MET_SHORT\r\n"
-                  "ElementDataFile = i16.raw\r\n",
-                  NULL, 0);
+                  "ElementDataFile = i16.raw",
+                  NULL, 0); /* the last line without its newline, as a hand-written .mhd may be */
         load_and_check(ctx, path, dims, unit, want, -3000.0, 4000.0);
     }
     {
