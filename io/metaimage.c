@@ -359,6 +359,162 @@ static char *data_path(const char *header_path, const char *name)
     return p;
 }
 
+/* What the header says, checked. */
+typedef struct met_image {
+    uint32_t dims[3];
+    size_t count;               /* dims product */
+    int type;                   /* index into met_types */
+    float spacing[3], origin[3], dirs[9];
+    int placed;                 /* Offset or TransformMatrix given: the volume carries them */
+    int msb, compressed;
+    long long header_size;      /* HeaderSize: bytes to skip, or -1 (0 when absent) */
+    long long compressed_size;  /* CompressedDataSize (0 when absent) */
+    const char *data_file;      /* ElementDataFile, in the header text */
+} met_image;
+
+/* Checks what the header says and fills *m: the grid, its type and place, and where the voxels
+ * are. Nothing is allocated. */
+static umbra_status header_interpret(umbra_context ctx, const char *func, const char *path,
+                                     const met_header *h, locale_t c_locale, met_image *m)
+{
+    double dims_d[3], spacing_d[3] = {1, 1, 1}, offset_d[3] = {0, 0, 0},
+                      matrix_d[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    long long ndims = 0, channels = 1;
+    int binary = 1, i;
+
+    memset(m, 0, sizeof *m);
+    m->count = 1;
+    m->type = -1;
+    if (h->value[K_OBJECT_TYPE] && strcmp(h->value[K_OBJECT_TYPE], "Image") != 0) {
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": ObjectType \"%.*s\" is not "
+                           "Image", func, path, QUOTE_MAX, h->value[K_OBJECT_TYPE]);
+    }
+    if (!h->value[K_NDIMS] || !parse_int(h->value[K_NDIMS], LLONG_MIN, LLONG_MAX, &ndims) ||
+        ndims != 3) {
+        /* A number other than 3 is a shape umbra does not read; anything else a broken header. */
+        return umbra__fail(ctx, h->value[K_NDIMS] && ndims != 0 ? UMBRA_ERROR_UNSUPPORTED
+                                                             : UMBRA_ERROR_FORMAT,
+                           "%s: \"%s\": NDims \"%.*s\": umbra reads 3-D volumes (NDims = 3)", func,
+                           path, QUOTE_MAX, h->value[K_NDIMS] ? h->value[K_NDIMS] : "(missing)");
+    }
+    if (!h->value[K_DIM_SIZE] || !parse_doubles(h->value[K_DIM_SIZE], 3, c_locale, dims_d)) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize \"%.*s\" is not three "
+                           "sizes", func, path, QUOTE_MAX,
+                           h->value[K_DIM_SIZE] ? h->value[K_DIM_SIZE] : "(missing)");
+    }
+    for (i = 0; i < 3; ++i) {
+        /* MetaIO keeps sizes in an int. */
+        if (!(dims_d[i] >= 1.0 && dims_d[i] <= (double)INT32_MAX) ||
+            dims_d[i] != floor(dims_d[i])) {
+            return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize \"%.*s\": each size "
+                               "must be an integer in 1..%d", func, path, QUOTE_MAX,
+                               h->value[K_DIM_SIZE], INT32_MAX);
+        }
+        m->dims[i] = (uint32_t)dims_d[i];
+        if (m->count > SIZE_MAX / m->dims[i]) {
+            return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize %s: too many voxels",
+                               func, path, h->value[K_DIM_SIZE]);
+        }
+        m->count *= m->dims[i];
+    }
+    if (!h->value[K_ELEMENT_TYPE]) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" has no ElementType", func, path);
+    }
+    for (i = 0; i < T_COUNT; ++i) {
+        if (strcmp(h->value[K_ELEMENT_TYPE], met_types[i].name) == 0) {
+            m->type = i;
+        }
+    }
+    if (m->type < 0) {
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: \"%s\": ElementType \"%.*s\" is not supported (MET_UCHAR, "
+                           "MET_CHAR, MET_USHORT, MET_SHORT, MET_UINT, MET_INT, MET_ULONG, "
+                           "MET_LONG, MET_ULONG_LONG, MET_LONG_LONG, MET_FLOAT, MET_DOUBLE)",
+                           func, path, QUOTE_MAX, h->value[K_ELEMENT_TYPE]);
+    }
+    if (h->value[K_CHANNELS] &&
+        (!parse_int(h->value[K_CHANNELS], LLONG_MIN, LLONG_MAX, &channels) || channels != 1)) {
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": ElementNumberOfChannels "
+                           "\"%.*s\": umbra reads one scalar per voxel (1)", func, path, QUOTE_MAX,
+                           h->value[K_CHANNELS]);
+    }
+    {
+        /* Booleans: BinaryData (default True: ITK always writes it), byte order, compression. */
+        const int slots[3] = {K_BINARY, K_MSB, K_COMPRESSED};
+        int *dst[3];
+        dst[0] = &binary;
+        dst[1] = &m->msb;
+        dst[2] = &m->compressed;
+        for (i = 0; i < 3; ++i) {
+            if (h->value[slots[i]]) {
+                int b = parse_bool(h->value[slots[i]]);
+                if (b < 0) {
+                    return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not "
+                                       "True or False", func, path, h->key[slots[i]], QUOTE_MAX,
+                                       h->value[slots[i]]);
+                }
+                *dst[i] = b;
+            }
+        }
+    }
+    if (!binary) {
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": BinaryData False (voxels as "
+                           "text) is not supported", func, path);
+    }
+    if (h->value[K_HEADER_SIZE] &&
+        !parse_int(h->value[K_HEADER_SIZE], -1, BYTES_MAX, &m->header_size)) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": HeaderSize \"%.*s\" is not -1 or "
+                           "a byte count", func, path, QUOTE_MAX, h->value[K_HEADER_SIZE]);
+    }
+    if (h->value[K_COMPRESSED_SIZE] &&
+        !parse_int(h->value[K_COMPRESSED_SIZE], 1, BYTES_MAX, &m->compressed_size)) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": CompressedDataSize \"%.*s\" is "
+                           "not a byte count > 0",
+                           func, path, QUOTE_MAX, h->value[K_COMPRESSED_SIZE]);
+    }
+
+    /* Where the voxels are in the world. */
+    if ((h->value[K_SPACING] && !parse_doubles(h->value[K_SPACING], 3, c_locale, spacing_d)) ||
+        (!h->value[K_SPACING] && h->value[K_SIZE] &&
+         !parse_doubles(h->value[K_SIZE], 3, c_locale, spacing_d))) {
+        int k = h->value[K_SPACING] ? K_SPACING : K_SIZE;
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not three finite "
+                           "numbers", func, path, h->key[k], QUOTE_MAX, h->value[k]);
+    }
+    for (i = 0; i < 3; ++i) {
+        m->spacing[i] = (float)spacing_d[i];
+        if (!(m->spacing[i] > 0.0f) || !isfinite(m->spacing[i])) {
+            int k = h->value[K_SPACING] ? K_SPACING : K_SIZE;
+            return umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                               "%s: \"%s\": %s \"%.*s\": each spacing must be a finite float > 0",
+                               func, path, h->key[k], QUOTE_MAX, h->value[k]);
+        }
+    }
+    if (h->value[K_OFFSET] && !parse_doubles(h->value[K_OFFSET], 3, c_locale, offset_d)) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not three finite "
+                           "numbers", func, path, h->key[K_OFFSET], QUOTE_MAX, h->value[K_OFFSET]);
+    }
+    if (h->value[K_MATRIX] && !parse_doubles(h->value[K_MATRIX], 9, c_locale, matrix_d)) {
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not nine finite "
+                           "numbers", func, path, h->key[K_MATRIX], QUOTE_MAX, h->value[K_MATRIX]);
+    }
+    for (i = 0; i < 3; ++i) {
+        m->origin[i] = (float)offset_d[i];
+        if (!isfinite(m->origin[i])) {
+            return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is beyond float "
+                               "range",
+                               func, path, h->key[K_OFFSET], QUOTE_MAX, h->value[K_OFFSET]);
+        }
+    }
+    for (i = 0; i < 9; ++i) {
+        m->dirs[i] = (float)matrix_d[i]; /* umbra_volume_create normalises and checks them */
+    }
+
+    m->placed = h->value[K_OFFSET] || h->value[K_MATRIX];
+    m->data_file = h->value[K_DATA_FILE];
+    return UMBRA_SUCCESS;
+}
+
 umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, umbra_volume *out)
 {
     static const char *const func = "umbra_volume_load_metaimage";
@@ -368,15 +524,11 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
     char *text = NULL, *dpath = NULL;
     unsigned char *packed = NULL;
     void *raw = NULL, *conv = NULL;
-    size_t file_size = 0, head_n, data_size = 0, count = 1, type_size, data_bytes, start, avail;
+    size_t file_size = 0, head_n, data_size = 0, type_size, data_bytes, start, avail;
     met_header h;
+    met_image m;
     const char *df_name;
-    double dims_d[3], spacing_d[3] = {1, 1, 1}, offset_d[3] = {0, 0, 0},
-                      matrix_d[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    uint32_t dims[3];
-    float spacing[3], origin[3], dirs[9];
-    long long ndims = 0, channels = 1, header_size = 0, compressed_size = 0;
-    int type = -1, binary = 1, msb = 0, compressed = 0, local, i;
+    int local;
 
     if (!out) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
@@ -416,152 +568,20 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
         goto fail;
     }
 
-    /* What the voxels are. */
-    if (h.value[K_OBJECT_TYPE] && strcmp(h.value[K_OBJECT_TYPE], "Image") != 0) {
-        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": ObjectType \"%.*s\" is not "
-                         "Image", func, path, QUOTE_MAX, h.value[K_OBJECT_TYPE]);
+    st = header_interpret(ctx, func, path, &h, c_locale, &m);
+    if (st != UMBRA_SUCCESS) {
         goto fail;
-    }
-    if (!h.value[K_NDIMS] || !parse_int(h.value[K_NDIMS], LLONG_MIN, LLONG_MAX, &ndims) ||
-        ndims != 3) {
-        st = umbra__fail(ctx, h.value[K_NDIMS] ? UMBRA_ERROR_UNSUPPORTED : UMBRA_ERROR_FORMAT,
-                         "%s: \"%s\": NDims \"%.*s\": umbra reads 3-D volumes (NDims = 3)", func,
-                         path, QUOTE_MAX, h.value[K_NDIMS] ? h.value[K_NDIMS] : "(missing)");
-        goto fail;
-    }
-    if (!h.value[K_DIM_SIZE] || !parse_doubles(h.value[K_DIM_SIZE], 3, c_locale, dims_d)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize \"%.*s\" is not three "
-                         "sizes", func, path, QUOTE_MAX,
-                         h.value[K_DIM_SIZE] ? h.value[K_DIM_SIZE] : "(missing)");
-        goto fail;
-    }
-    for (i = 0; i < 3; ++i) {
-        /* MetaIO keeps sizes in an int. */
-        if (!(dims_d[i] >= 1.0 && dims_d[i] <= (double)INT32_MAX) || dims_d[i] != floor(dims_d[i])) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize \"%.*s\": each size "
-                             "must be an integer in 1..%d", func, path, QUOTE_MAX,
-                             h.value[K_DIM_SIZE], INT32_MAX);
-            goto fail;
-        }
-        dims[i] = (uint32_t)dims_d[i];
-        if (count > SIZE_MAX / dims[i]) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize %s: too many voxels",
-                             func, path, h.value[K_DIM_SIZE]);
-            goto fail;
-        }
-        count *= dims[i];
-    }
-    if (!h.value[K_ELEMENT_TYPE]) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" has no ElementType", func, path);
-        goto fail;
-    }
-    for (i = 0; i < T_COUNT; ++i) {
-        if (strcmp(h.value[K_ELEMENT_TYPE], met_types[i].name) == 0) {
-            type = i;
-        }
-    }
-    if (type < 0) {
-        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                         "%s: \"%s\": ElementType \"%.*s\" is not supported (MET_UCHAR, MET_CHAR, "
-                         "MET_USHORT, MET_SHORT, MET_UINT, MET_INT, MET_ULONG, MET_LONG, "
-                         "MET_ULONG_LONG, MET_LONG_LONG, MET_FLOAT, MET_DOUBLE)",
-                         func, path, QUOTE_MAX, h.value[K_ELEMENT_TYPE]);
-        goto fail;
-    }
-    if (h.value[K_CHANNELS] &&
-        (!parse_int(h.value[K_CHANNELS], LLONG_MIN, LLONG_MAX, &channels) || channels != 1)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": ElementNumberOfChannels "
-                         "\"%.*s\": umbra reads one scalar per voxel (1)", func, path, QUOTE_MAX,
-                         h.value[K_CHANNELS]);
-        goto fail;
-    }
-    {
-        /* Booleans: BinaryData (default True here: ITK always writes it), byte order, compression. */
-        const int slots[3] = {K_BINARY, K_MSB, K_COMPRESSED};
-        int *dst[3];
-        dst[0] = &binary;
-        dst[1] = &msb;
-        dst[2] = &compressed;
-        for (i = 0; i < 3; ++i) {
-            if (h.value[slots[i]]) {
-                int b = parse_bool(h.value[slots[i]]);
-                if (b < 0) {
-                    st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not "
-                                     "True or False", func, path, h.key[slots[i]], QUOTE_MAX,
-                                     h.value[slots[i]]);
-                    goto fail;
-                }
-                *dst[i] = b;
-            }
-        }
-    }
-    if (!binary) {
-        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": BinaryData False (voxels as "
-                         "text) is not supported", func, path);
-        goto fail;
-    }
-    if (h.value[K_HEADER_SIZE] &&
-        !parse_int(h.value[K_HEADER_SIZE], -1, BYTES_MAX, &header_size)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": HeaderSize \"%.*s\" is not -1 or a "
-                         "byte count", func, path, QUOTE_MAX, h.value[K_HEADER_SIZE]);
-        goto fail;
-    }
-    if (h.value[K_COMPRESSED_SIZE] &&
-        !parse_int(h.value[K_COMPRESSED_SIZE], 1, BYTES_MAX, &compressed_size)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": CompressedDataSize \"%.*s\" is not "
-                         "a byte count > 0", func, path, QUOTE_MAX, h.value[K_COMPRESSED_SIZE]);
-        goto fail;
-    }
-
-    /* Where the voxels are in the world. */
-    if ((h.value[K_SPACING] && !parse_doubles(h.value[K_SPACING], 3, c_locale, spacing_d)) ||
-        (!h.value[K_SPACING] && h.value[K_SIZE] &&
-         !parse_doubles(h.value[K_SIZE], 3, c_locale, spacing_d))) {
-        int k = h.value[K_SPACING] ? K_SPACING : K_SIZE;
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not three finite "
-                         "numbers", func, path, h.key[k], QUOTE_MAX, h.value[k]);
-        goto fail;
-    }
-    for (i = 0; i < 3; ++i) {
-        spacing[i] = (float)spacing_d[i];
-        if (!(spacing[i] > 0.0f) || !isfinite(spacing[i])) {
-            int k = h.value[K_SPACING] ? K_SPACING : K_SIZE;
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\": each spacing must "
-                             "be a finite float > 0", func, path, h.key[k], QUOTE_MAX, h.value[k]);
-            goto fail;
-        }
-    }
-    if (h.value[K_OFFSET] && !parse_doubles(h.value[K_OFFSET], 3, c_locale, offset_d)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not three finite "
-                         "numbers", func, path, h.key[K_OFFSET], QUOTE_MAX, h.value[K_OFFSET]);
-        goto fail;
-    }
-    if (h.value[K_MATRIX] && !parse_doubles(h.value[K_MATRIX], 9, c_locale, matrix_d)) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is not nine finite "
-                         "numbers", func, path, h.key[K_MATRIX], QUOTE_MAX, h.value[K_MATRIX]);
-        goto fail;
-    }
-    for (i = 0; i < 3; ++i) {
-        origin[i] = (float)offset_d[i];
-        if (!isfinite(origin[i])) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": %s \"%.*s\" is beyond float "
-                             "range", func, path, h.key[K_OFFSET], QUOTE_MAX, h.value[K_OFFSET]);
-            goto fail;
-        }
-    }
-    for (i = 0; i < 9; ++i) {
-        dirs[i] = (float)matrix_d[i]; /* umbra_volume_create normalises and checks them */
     }
 
     /* Where the voxels are on disk, and how many bytes they take: known before any allocation. */
-    type_size = met_types[type].size;
-    if (count > SIZE_MAX / type_size) {
+    type_size = met_types[m.type].size;
+    if (m.count > SIZE_MAX / type_size) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": DimSize %s of %zu bytes: too large",
                          func, path, h.value[K_DIM_SIZE], type_size);
         goto fail;
     }
-    data_bytes = count * type_size;
-    df_name = h.value[K_DATA_FILE];
+    data_bytes = m.count * type_size;
+    df_name = m.data_file;
     local = strcmp(df_name, "LOCAL") == 0 || strcmp(df_name, "Local") == 0 ||
             strcmp(df_name, "local") == 0;
     if (!local && (strncmp(df_name, "LIST", 4) == 0 || strchr(df_name, '%'))) {
@@ -575,14 +595,14 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
                          path);
         goto fail;
     }
-    if (local && header_size != 0) {
+    if (local && m.header_size != 0) {
         st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": HeaderSize %lld with "
-                         "ElementDataFile LOCAL is not supported", func, path, header_size);
+                         "ElementDataFile LOCAL is not supported", func, path, m.header_size);
         goto fail;
     }
-    if (compressed && header_size != 0) {
+    if (m.compressed && m.header_size != 0) {
         st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": HeaderSize %lld with "
-                         "CompressedData True is not supported", func, path, header_size);
+                         "CompressedData True is not supported", func, path, m.header_size);
         goto fail;
     }
     if (local) {
@@ -604,7 +624,7 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
             goto fail;
         }
         /* HeaderSize -1: the voxels are the file's last bytes. */
-        start = header_size >= 0 ? (size_t)header_size
+        start = m.header_size >= 0 ? (size_t)m.header_size
                                  : (data_size >= data_bytes ? data_size - data_bytes : 0);
     }
     if (start > data_size) {
@@ -613,28 +633,28 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
         goto fail;
     }
     avail = data_size - start;
-    if (!compressed && avail != data_bytes) {
+    if (!m.compressed && avail != data_bytes) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                          "%s: \"%s\" holds %zu bytes of voxels after byte %zu, expected %zu "
                          "(DimSize %s of %s, %zu bytes each)",
                          func, local ? path : dpath, avail, start, data_bytes,
-                         h.value[K_DIM_SIZE], met_types[type].name, type_size);
+                         h.value[K_DIM_SIZE], met_types[m.type].name, type_size);
         goto fail;
     }
-    if (compressed) {
-        size_t packed_n = compressed_size > 0 ? (size_t)compressed_size : avail;
+    if (m.compressed) {
+        size_t packed_n = m.compressed_size > 0 ? (size_t)m.compressed_size : avail;
         if (packed_n > avail) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": CompressedDataSize %zu, but only "
-                             "%zu bytes follow the header", func, local ? path : dpath, packed_n,
-                             avail);
+            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": CompressedDataSize %zu, but "
+                             "only %zu bytes follow the header",
+                             func, local ? path : dpath, packed_n, avail);
             goto fail;
         }
         if (data_bytes / ZLIB_MAX_RATIO > packed_n + 64) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                             "%s: \"%s\": %zu compressed bytes cannot hold the %zu bytes of DimSize "
-                             "%s of %s (deflate expands at most %ux)",
+                             "%s: \"%s\": %zu compressed bytes cannot hold the %zu bytes of "
+                             "DimSize %s of %s (deflate expands at most %ux)",
                              func, local ? path : dpath, packed_n, data_bytes,
-                             h.value[K_DIM_SIZE], met_types[type].name, ZLIB_MAX_RATIO);
+                             h.value[K_DIM_SIZE], met_types[m.type].name, ZLIB_MAX_RATIO);
             goto fail;
         }
         avail = packed_n;
@@ -653,7 +673,7 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
                          "voxels of \"%s\"", func, data_bytes, path);
         goto fail;
     }
-    if (compressed) {
+    if (m.compressed) {
         packed = malloc(avail ? avail : 1);
         if (!packed) {
             st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes for "
@@ -672,28 +692,27 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
-    if (type_size > 1 && (msb != 0) != umbra__host_is_big_endian()) {
-        umbra__swap_bytes(raw, count, type_size);
+    if (type_size > 1 && (m.msb != 0) != umbra__host_is_big_endian()) {
+        umbra__swap_bytes(raw, m.count, type_size);
     }
-    if (type != T_UCHAR && type != T_USHORT && type != T_SHORT && type != T_FLOAT) {
-        conv = malloc(count * umbra_scalar_type_size(met_types[type].umbra));
+    if (m.type != T_UCHAR && m.type != T_USHORT && m.type != T_SHORT && m.type != T_FLOAT) {
+        conv = malloc(m.count * umbra_scalar_type_size(met_types[m.type].umbra));
         if (!conv) {
             st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu converted "
-                             "voxels for \"%s\"", func, count, path);
+                             "voxels for \"%s\"", func, m.count, path);
             goto fail;
         }
-        if (!convert(raw, type, count, conv)) {
+        if (!convert(raw, m.type, m.count, conv)) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": a %s voxel is not a finite "
-                             "float32", func, path, met_types[type].name);
+                             "float32", func, path, met_types[m.type].name);
             goto fail;
         }
         free(raw);
         raw = conv;
         conv = NULL;
     }
-    st = umbra__volume_from_host(ctx, raw, met_types[type].umbra, dims, spacing,
-                                 (h.value[K_OFFSET] || h.value[K_MATRIX]) ? origin : NULL,
-                                 (h.value[K_OFFSET] || h.value[K_MATRIX]) ? dirs : NULL, out);
+    st = umbra__volume_from_host(ctx, raw, met_types[m.type].umbra, m.dims, m.spacing,
+                                 m.placed ? m.origin : NULL, m.placed ? m.dirs : NULL, out);
 
 fail:
     free(conv);

@@ -417,6 +417,8 @@ static void test_metaimage_broken_files_refused(void **state)
     refused(ctx, "rgb.mha", HEAD3 "DimSize = 2 2 2\nElementNumberOfChannels = 3\n"
             "ElementType = MET_UCHAR\nElementDataFile = LOCAL\n", data, 24,
             UMBRA_ERROR_UNSUPPORTED, "ElementNumberOfChannels \"3\"", NULL);
+    refused(ctx, "ndx.mha", "NDims = three\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+            "ElementDataFile = LOCAL\n", data, 8, UMBRA_ERROR_FORMAT, "NDims \"three\"", NULL);
     refused(ctx, "nd4.mha", "NDims = 4\nDimSize = 2 2 2 1\nElementType = MET_UCHAR\n"
             "ElementDataFile = LOCAL\n", data, 8, UMBRA_ERROR_UNSUPPORTED, "NDims \"4\"", NULL);
     refused(ctx, "tube.mha", "ObjectType = Tube\nNDims = 3\nDimSize = 2 2 2\n"
