@@ -623,9 +623,12 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
          equal_nocase(path + strlen(path) - 7, 7, ".nii.gz"))) {
         return umbra_volume_load_nifti(ctx, path, out);
     }
+    if (equal_nocase(ext, strlen(ext), "mha") || equal_nocase(ext, strlen(ext), "mhd")) {
+        return umbra_volume_load_metaimage(ctx, path, out);
+    }
     return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                        "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD), .nii, "
-                       ".nii.gz (NIfTI) and .dat (Voreen); MetaImage (.mha, .mhd) and VTK (.vti) "
-                       "are not supported; load headerless raw files with umbra_volume_load_raw",
+                       ".nii.gz (NIfTI), .mha, .mhd (MetaImage) and .dat (Voreen); VTK (.vti) is "
+                       "not supported; load headerless raw files with umbra_volume_load_raw",
                        __func__, path);
 }

@@ -823,8 +823,8 @@ static void test_nifti_broken_files_refused(void **state)
     test_assert_failed(ctx, umbra_volume_load(ctx, bad, &vol), UMBRA_ERROR_IO, "not a regular file",
                   NULL);
     remove(bad);
-    test_assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "x.mha"), &vol),
-                  UMBRA_ERROR_INVALID_ARGUMENT, "unknown extension", "MetaImage");
+    test_assert_failed(ctx, umbra_volume_load(ctx, tmp_path(bad, "x.vti"), &vol),
+                  UMBRA_ERROR_INVALID_ARGUMENT, "unknown extension", "VTK (.vti)");
     assert_int_equal(umbra_volume_load_nifti(ctx, path, NULL), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_int_equal(umbra_context_take_error(ctx, NULL), UMBRA_ERROR_INVALID_ARGUMENT);
 }

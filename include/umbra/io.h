@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, Voreen .dat and raw
- * files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
+/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, MetaImage, Voreen .dat
+ * and raw files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
  * EXR.
  *
  * It is a library of its own (libumbra_io, CMake target umbra::io, pkg-config umbra-io) that links
@@ -22,7 +22,8 @@ extern "C" {
 
 /* ---- volumes --------------------------------------------------------------------------------- */
 
-/* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .dat (Voreen). */
+/* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .mha / .mhd
+ * (MetaImage), .dat (Voreen). */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
@@ -54,10 +55,28 @@ UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path
  * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
  * the file's units; the sform (else the qform) also places the volume in the file's world (its
  * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). The header's sizes are
- * checked against the file before the voxels are read. MetaImage and VTK .vti are not supported
- * (no small maintained library). */
+ * checked against the file before the voxels are read. */
 UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
                                                umbra_volume *out);
+
+/* Loads a MetaImage volume (ITK's format): .mha with the voxels after the header
+ * (ElementDataFile = LOCAL) or .mhd naming one data file (.raw, or zlib/gzip-compressed .zraw),
+ * relative to the header unless absolute; header and data must be regular files. NDims 3, one
+ * channel; BinaryData True; byte order from BinaryDataByteOrderMSB / ElementByteOrderMSB;
+ * CompressedData with or without CompressedDataSize; HeaderSize (a count of bytes to skip, or -1:
+ * the voxels end the file) for uncompressed data files. MET_UCHAR, MET_USHORT, MET_SHORT and
+ * MET_FLOAT are kept; MET_CHAR becomes int16; MET_INT, MET_UINT, MET_LONG, MET_ULONG,
+ * MET_LONG_LONG, MET_ULONG_LONG and MET_DOUBLE become float32. Spacing is ElementSpacing (else
+ * ElementSize, else 1). With Offset (or Position, Origin) or TransformMatrix (or Rotation,
+ * Orientation; values 3a..3a+2 are index axis a's direction) the volume carries that
+ * index-to-world transform, in the file's world as written (ITK's LPS); with neither the box is
+ * centred. The sizes are checked against the file before any voxel buffer is allocated: raw data
+ * must fill the rest of its file exactly, compressed data can expand at most 1032:1 and must end
+ * exactly at the declared size; anything else, a repeated or malformed key, is
+ * UMBRA_ERROR_FORMAT naming the value; what umbra does not read (several channels or files, ASCII
+ * voxels, other types) is UMBRA_ERROR_UNSUPPORTED. */
+UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
+                                                   umbra_volume *out);
 
 typedef struct umbra_raw_desc {
     size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */

@@ -219,9 +219,10 @@ void bind_objects(nb::module_ &m)
                 return Volume(c.h, v);
             },
             "path"_a,
-            "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib) or .dat (Voreen) "
-            "through umbra_io, with the file's spacing and world transform (NRRD space "
-            "directions, NIfTI sform/qform).")
+            "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib), .mha/.mhd "
+            "(MetaImage) or .dat (Voreen) through umbra_io, with the file's spacing and world "
+            "transform (NRRD space directions, NIfTI sform/qform, MetaImage Offset and "
+            "TransformMatrix).")
         .def(
             "load_transfer_function",
             [](Context &c, const std::string &path) {

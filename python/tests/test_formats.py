@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Issue 13's acceptance through Python: a NIfTI volume written with nibabel and a ParaView preset
-rendered with technique cssm from Python and by umbra-render --volume x.nii.gz --tf preset.json
-give the same pixels. Also: transfer-function data ranges and ParaView presets from Python."""
+"""Issue 13's acceptance through Python: a NIfTI volume written with nibabel (and a MetaImage
+written here) and a ParaView preset rendered with technique cssm from Python and by umbra-render
+--volume x.nii.gz --tf preset.json (x.mha) give the same pixels. Also: transfer-function data
+ranges and ParaView presets from Python."""
 
 import json
 import os
@@ -154,3 +155,72 @@ def test_paraview_presets(ctx, tmp_path):
     with pytest.raises(umbra.Error) as e:
         ctx.load_paraview(str(CT_BONE), resolution=1)
     assert e.value.status == umbra.Status.ERROR_INVALID_ARGUMENT
+
+
+def write_mha(path, zyx, spacing, offset, matrix, compressed):
+    """A MetaImage as ITK writes it: a text header, then the voxels (x fastest), zlib-compressed
+    when asked."""
+    import zlib
+    types = {np.dtype(np.uint8): "MET_UCHAR", np.dtype(np.int16): "MET_SHORT",
+             np.dtype(np.float32): "MET_FLOAT"}
+    data = np.ascontiguousarray(zyx).astype(zyx.dtype.newbyteorder("<")).tobytes()
+    if compressed:
+        data = zlib.compress(data)
+    nz, ny, nx = zyx.shape
+    head = ["ObjectType = Image", "NDims = 3", "BinaryData = True",
+            "BinaryDataByteOrderMSB = False", f"CompressedData = {compressed}"]
+    if compressed:
+        head.append(f"CompressedDataSize = {len(data)}")
+    head += ["TransformMatrix = " + " ".join(repr(float(v)) for v in np.ravel(matrix)),
+             "Offset = " + " ".join(repr(float(v)) for v in offset),
+             "CenterOfRotation = 0 0 0",
+             "ElementSpacing = " + " ".join(repr(float(v)) for v in spacing),
+             f"DimSize = {nx} {ny} {nz}", "AnatomicalOrientation = RAI",
+             f"ElementType = {types[zyx.dtype]}", "ElementDataFile = LOCAL"]
+    path.write_bytes(("\n".join(head) + "\n").encode() + data)
+
+
+@pytest.mark.parametrize("dtype,compressed", [(np.int16, True), (np.uint8, False),
+                                              (np.float32, True)])
+def test_metaimage_loads_as_the_array_and_matches_the_cli(ctx, cli, tmp_path, dtype, compressed):
+    """An .mha written here loads with the header's spacing, offset and axis directions and the
+    array's values, and umbra-render --volume x.mha --tf preset draws what Python draws from the
+    loaded volume."""
+    n = 20
+    z, y, x = np.mgrid[-1:1:n * 1j, -1:1:n * 1j, -1:1:(n + 4) * 1j]
+    r = np.sqrt(x * x + (1.3 * y) ** 2 + z * z)
+    zyx = (np.where(r < 0.8, 200.0, 10.0) + 40 * x).astype(dtype)
+    spacing = (0.9, 1.1, 1.7)
+    offset = (-12.0, 30.5, 4.25)
+    c, s = np.cos(0.5), np.sin(0.5)
+    matrix = np.array([[c, s, 0], [-s, c, 0], [0, 0, -1]])     # row a: index axis a's direction
+    mha = tmp_path / "x.mha"
+    write_mha(mha, zyx, spacing, offset, matrix, compressed)
+    exr = tmp_path / "x.exr"
+    env = dict(os.environ)
+    env.setdefault("POCL_CACHE_DIR", str(tmp_path / "pocl-cache"))
+    preset = REPO / "examples" / "presets" / "cool_to_warm.json"
+    subprocess.run([str(cli), "--volume", str(mha), "--tf", str(preset), "--technique", "cssm",
+                    "--size", f"{W}x{H}", "--out", str(exr)], check=True, env=env,
+                   capture_output=True)
+    c_pixels = ctx.read_image(str(exr))
+    with ctx.load_volume(str(mha)) as theirs, \
+            umbra.Volume(ctx, zyx, spacing=spacing, origin=offset, directions=matrix) as mine:
+        a, b = mine.info, theirs.info
+        assert b.transform_given
+        assert a.dims == b.dims == (n + 4, n, n)
+        assert np.allclose(a.spacing, b.spacing, rtol=1e-6)
+        assert np.allclose(b.origin, offset, atol=1e-6)
+        assert np.allclose(a.directions, b.directions, atol=1e-6)
+        assert np.allclose(a.center, b.center, atol=1e-4)
+        assert a.value_range == b.value_range
+    with ctx.load_volume(str(mha)) as vol, ctx.load_transfer_function(str(preset)) as tf:
+        info = vol.info
+        camera = umbra.Camera.orbit(CLI_CAMERA_DIR, info.diagonal, 30, center=info.center)
+        with umbra.Renderer(ctx, vol, tf, camera=camera,
+                            light=umbra.Light.directional(CLI_LIGHT_DIR)) as rnd:
+            rnd.set_options(ground_plane=True, background=CLI_BACKGROUND)
+            py_pixels = rnd.render(W, H, technique="cssm")
+    assert py_pixels.shape == c_pixels.shape == (H, W, 4)
+    assert np.max(np.abs(py_pixels - c_pixels)) <= 1e-6
+    assert np.ptp(py_pixels[..., :3]) > 0.2
