@@ -32,7 +32,7 @@ inline float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, flo
     float3 l = to_light(F, p).xyz;
     float3 hv = normalize(l + view);
     float diff = fabs(dot(n, l));
-    float spec = pow(fabs(dot(n, hv)), F->shininess);
+    float spec = shading_power(fabs(dot(n, hv)), F->shininess);
     return c * (amb + light * F->kd * diff) + light * F->ks * spec;
 }
 
