@@ -366,9 +366,22 @@ typedef struct bench_case {
     int nrows;
 } bench_case;
 
+/* The 1-minute load average from /proc/loadavg (Linux), or a negative value. */
+static double load_average(void)
+{
+    double load = -1.0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1)
+            load = -1.0;
+        fclose(f);
+    }
+    return load;
+}
+
 static void write_results(const options *o, int argc, char **argv, const bench_volume *v,
                           const char *device, const bench_case *cases, int ncases,
-                          const umbra_render_desc *shaded)
+                          const umbra_render_desc *shaded, const double load[2])
 {
     char path[1100], cpu[600], date[64];
     time_t now = time(NULL);
@@ -412,8 +425,14 @@ static void write_results(const options *o, int argc, char **argv, const bench_v
                "same coefficients and light)\n",
             shaded->kd, shaded->ks, shaded->shininess);
     fprintf(f, "- medians of %d frames after %d warm-up frames; umbra, native C and VTK take "
-               "turns frame by frame, unshaded and shaded in the same turn\n\n",
+               "turns frame by frame, unshaded and shaded in the same turn\n",
             o->runs, o->warmup);
+    if (load[0] >= 0.0 && load[1] >= 0.0)
+        fprintf(f, "- load average (1 minute) before / after the frames: %.1f / %.1f (the three "
+                   "renderers use every CPU; a load above that means other processes shared "
+                   "the machine: compare the ratios of one run, not times across runs)\n",
+                load[0], load[1]);
+    fprintf(f, "\n");
     fprintf(f, "| case | ms median | samples/s | samples | ms min | ms max |\n"
                "|---|---:|---:|---:|---:|---:|\n");
     for (int c = 0; c < ncases; ++c)
@@ -698,7 +717,8 @@ int bench_raycast(int argc, char **argv)
     /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, both
      * cases in each turn, so that a change in the machine's load (other processes) during the
      * measurement touches all alike. */
-    double dev, wall;
+    double dev, wall, load[2];
+    load[0] = load_average();
     for (int i = 0; i < o.warmup; ++i)
         for (int c = 0; c < ncases; ++c) {
             bench_case *bc = &cases[c];
@@ -723,6 +743,7 @@ int bench_raycast(int argc, char **argv)
                 vtk_running = 0;
             }
         }
+    load[1] = load_average();
     if (vtk_running && vtk_stop(&peer) != 0)
         fprintf(stderr, "vtk_fixedpoint: bench/vtk_raycast.py exited with an error\n");
 
@@ -747,7 +768,7 @@ int bench_raycast(int argc, char **argv)
             save_png(ctx, o.save, n_native, o.width, o.height, cases[c].img_native);
         }
     if (o.results)
-        write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded);
+        write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded, load);
     status = 0;
 done:
     if (vtk_running)

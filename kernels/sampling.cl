@@ -58,11 +58,13 @@ inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * trilinear sampler s, one voxel e each way, in value per world unit, computed in one pass over
  * the 32 voxels those six samples read (a 4 x 2 x 2 block through p's cell along each axis):
  * as all six share p's fractions, each axis' component is the trilinear interpolation, over p's
- * cell, of the voxels' central differences v[i+1] - v[i-1]. Six separate samples cost 48 loads,
- * six index computations and, on PoCL, 2.7x the unshaded frame; this is the shaded frame's
- * inner loop. Indices come from the unclamped position and are clamped one by one, which
- * repeats the border voxels exactly as clamping each sample's position does (a position
- * clamped to the border interpolates between two copies of the border voxel). It differs from
+ * cell, of the voxels' central differences v[i+1] - v[i-1]. Six separate samples cost 48 loads
+ * and six index computations: on PoCL a shaded 256^2 bonsai frame took 1.38x the unshaded one
+ * with them, 1.23-1.29x with this (both with kernels/common.cl's shading_power; frames of one
+ * run each, on a loaded 2-core machine). Indices come from the unclamped position and are
+ * clamped one by one, which repeats the border voxels exactly as clamping each sample's
+ * position does (a position clamped to the border interpolates between two copies of the
+ * border voxel). It differs from
  * the six samples only by float rounding, and less of it: the differences are taken before the
  * interpolation, not between two interpolated values (tests/test_raycast.c bounds the image
  * change against the six-sample form). */
@@ -79,8 +81,10 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
     int3 c = clamp(i + 1, (int3)(0), top), d = clamp(i + 2, (int3)(0), top);
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t xa = (size_t)a.x, xb = (size_t)b.x, xc = (size_t)c.x, xd = (size_t)d.x;
-    size_t ya = (size_t)a.y * sy, yb = (size_t)b.y * sy, yc = (size_t)c.y * sy, yd = (size_t)d.y * sy;
-    size_t za = (size_t)a.z * sz, zb = (size_t)b.z * sz, zc = (size_t)c.z * sz, zd = (size_t)d.z * sz;
+    size_t ya = (size_t)a.y * sy, yb = (size_t)b.y * sy;
+    size_t yc = (size_t)c.y * sy, yd = (size_t)d.y * sy;
+    size_t za = (size_t)a.z * sz, zb = (size_t)b.z * sz;
+    size_t zc = (size_t)c.z * sz, zd = (size_t)d.z * sz;
     /* p's cell: the corners (b or c per axis) */
     float v_bbb = vol[zb + yb + xb], v_cbb = vol[zb + yb + xc];
     float v_bcb = vol[zb + yc + xb], v_ccb = vol[zb + yc + xc];
