@@ -7,6 +7,9 @@
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
  *    pixel (<= 1e-4 per channel; with the exact reference's adaptive shadow rays <= 1e-3, and
  *    at most 0.5% of values over 1e-4) and sample for sample;
+ *  - gradient shading's faster form (one 32-voxel stencil, binary powering) changes the image
+ *    by at most 1e-4 against the form before it (six trilinear samples, pow), on a noisy uint8
+ *    volume with flat runs and anisotropic spacing too;
  *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
  *    edge cases (odd brick sizes, rays running in cell faces);
  *  - an application's own cl_context / device / queue work and are left as they were found;
