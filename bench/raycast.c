@@ -2,8 +2,9 @@
 /* bench/raycast.c: `umbra-bench raycast`, the foundation's speed check.
  *
  * One view of the bonsai CT (or its procedural stand-in, bench_util.c) at 512x512, view step 0.5
- * voxel, no shadows (technique none), no gradient shading, no jitter, early ray termination at
- * 0.99 and empty-space skipping on, rendered by
+ * voxel, no shadows (technique none), no jitter, early ray termination at 0.99 and empty-space
+ * skipping on, twice: without shading and with gradient Blinn-Phong shading (--shading or
+ * --no-shading times one of the two), rendered by
  *   umbra     umbra_renderer_render on the OpenCL device (PoCL's CPU device here): device time of
  *             the kernel (stats.render_ms) and, as umbra_wall, the wall time of the whole call
  *             including the read-back of the image;
@@ -76,6 +77,7 @@ typedef struct options {
     const char *results;
     const char *device;
     const char *save;
+    int shading; /* -1: both cases (default), 0: unshaded only, 1: shaded only */
 } options;
 
 static void usage(FILE *f)
@@ -88,14 +90,17 @@ static void usage(FILE *f)
             "  --step S         view step in voxels (default 0.5)\n"
             "  --volume FILE    volume instead of the bonsai (.nrrd/.nhdr/.dat)\n"
             "  --procedural     use the procedural 256^3 stand-in even if the bonsai is present\n"
-            "  --no-vtk         skip the VTK row\n"
+            "  --shading        time only the shaded case (gradient Blinn-Phong)\n"
+            "  --no-shading     time only the unshaded case (default: both, in turn)\n"
+            "  --no-vtk         skip the VTK rows\n"
             "  --device SPEC    OpenCL device (P:D or a name substring; default $UMBRA_DEVICE)\n"
             "  --results DIR    also write DIR/raycast.csv and DIR/raycast.md\n"
             "  --save PREFIX    write PREFIX_umbra.png, PREFIX_native_c.png (and _vtk.png)\n"
             "Prints CSV (" BENCH_CSV_HEADER ") on stdout: rows umbra (device time),\n"
             "umbra_wall, native_c and, when python3 imports vtk, vtk_fixedpoint (frames\n"
-            "interleaved with umbra's); the ratio of umbra's samples/s to native_c's and of\n"
-            "VTK's time per frame to umbra's on stderr.\n");
+            "interleaved with umbra's), each again with the suffix _shaded for the shaded case;\n"
+            "the ratio of umbra's samples/s to native_c's and of VTK's time per frame to\n"
+            "umbra's, per case, on stderr.\n");
 }
 
 static int parse(int argc, char **argv, options *o)
@@ -110,6 +115,7 @@ static int parse(int argc, char **argv, options *o)
     o->results = NULL;
     o->device = NULL;
     o->save = NULL;
+    o->shading = -1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         long n;
@@ -156,6 +162,10 @@ static int parse(int argc, char **argv, options *o)
             ++i;
         } else if (strcmp(a, "--procedural") == 0) {
             o->procedural = 1;
+        } else if (strcmp(a, "--shading") == 0) {
+            o->shading = 1;
+        } else if (strcmp(a, "--no-shading") == 0) {
+            o->shading = 0;
         } else if (strcmp(a, "--no-vtk") == 0) {
             o->vtk = 0;
         } else {
@@ -219,7 +229,8 @@ typedef struct vtk_peer {
 
 /* Starts the script on the benchmark's view; 0 once it has set up and warmed up. */
 static int vtk_start(const options *o, const bench_volume *v, const umbra_camera *cam,
-                     float step_world, vtk_peer *peer, char *why, size_t why_size)
+                     const umbra_render_desc *shaded, const umbra_light *light, float step_world,
+                     vtk_peer *peer, char *why, size_t why_size)
 {
     memset(peer, 0, sizeof *peer);
     peer->pid = -1;
@@ -248,11 +259,14 @@ static int vtk_start(const options *o, const bench_volume *v, const umbra_camera
     snprintf(cmd, sizeof cmd,
              "exec %s'%s' '%s/bench/vtk_raycast.py' --serve --nrrd '%s' --size %u %u "
              "--eye %.9g %.9g %.9g --target %.9g %.9g %.9g --up %.9g %.9g %.9g --fovy %.9g "
-             "--step %.9g --range %.9g %.9g --tf '%s' --warmup %d%s",
+             "--step %.9g --range %.9g %.9g --tf '%s' --warmup %d --shading %.9g %.9g %.9g "
+             "--light %.9g %.9g %.9g%s",
              xvfb ? "xvfb-run -a " : "", py, UMBRA_SOURCE_DIR, v->path, o->width, o->height,
              cam->eye[0], cam->eye[1], cam->eye[2], cam->target[0], cam->target[1],
              cam->target[2], cam->up[0], cam->up[1], cam->up[2], cam->fovy_degrees, step_world,
-             v->value_min, v->value_max, tf, o->warmup, save);
+             v->value_min, v->value_max, tf, o->warmup, shaded->kd, shaded->ks,
+             shaded->shininess, light->direction[0], light->direction[1], light->direction[2],
+             save);
     int in[2], out[2];
     if (pipe(in) != 0)
         goto broken;
@@ -293,12 +307,12 @@ broken:
     return -1;
 }
 
-/* One frame; its wall time in ms, or a negative value if the peer failed. */
-static double vtk_frame(vtk_peer *peer)
+/* One frame, shaded or not; its wall time in ms, or a negative value if the peer failed. */
+static double vtk_frame(vtk_peer *peer, int shaded)
 {
     char line[256];
     double ms;
-    if (fputs("frame\n", peer->to) == EOF || fflush(peer->to) != 0)
+    if (fputs(shaded ? "frame shaded\n" : "frame\n", peer->to) == EOF || fflush(peer->to) != 0)
         return -1.0;
     while (fgets(line, sizeof line, peer->from))
         if (sscanf(line, "ms %lf", &ms) == 1)
@@ -334,9 +348,40 @@ typedef struct row {
     uint64_t samples;
 } row;
 
+/* One of the two views the benchmark times: without shading (the foundation's check) or with
+ * gradient Blinn-Phong shading; everything else alike. */
+typedef struct bench_case {
+    int shading;
+    const char *suffix; /* "" or "_shaded": appended to the row names */
+    umbra_renderer r;
+    cpu_scene cs; /* cpu_prepare keeps a pointer to it */
+    cpu_prepared *prepared;
+    float *img_umbra, *img_native;
+    double *t_dev, *t_wall, *t_native, *t_vtk;
+    uint64_t samples_umbra, samples_native;
+    double diff; /* largest pixel difference umbra vs native C */
+    double diff_six; /* shaded: umbra vs the C twin's shading before issue #12; else -1 */
+    double ratio, vtk_ratio;
+    row rows[4];
+    int nrows;
+} bench_case;
+
+/* The 1-minute load average from /proc/loadavg (Linux), or a negative value. */
+static double load_average(void)
+{
+    double load = -1.0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1)
+            load = -1.0;
+        fclose(f);
+    }
+    return load;
+}
+
 static void write_results(const options *o, int argc, char **argv, const bench_volume *v,
-                          const char *device, const row *rows, int nrows, double ratio,
-                          double vtk_ratio, double image_diff, const char *samples_equal)
+                          const char *device, const bench_case *cases, int ncases,
+                          const umbra_render_desc *shaded, const double load[2])
 {
     char path[1100], cpu[600], date[64];
     time_t now = time(NULL);
@@ -350,8 +395,9 @@ static void write_results(const options *o, int argc, char **argv, const bench_v
         return;
     }
     fprintf(f, "%s\n", BENCH_CSV_HEADER);
-    for (int i = 0; i < nrows; ++i)
-        bench_csv_row(f, rows[i].name, rows[i].t, rows[i].samples);
+    for (int c = 0; c < ncases; ++c)
+        for (int i = 0; i < cases[c].nrows; ++i)
+            bench_csv_row(f, cases[c].rows[i].name, cases[c].rows[i].t, cases[c].rows[i].samples);
     fclose(f);
     snprintf(path, sizeof path, "%s/raycast.md", o->results);
     f = fopen(path, "w");
@@ -371,28 +417,56 @@ static void write_results(const options *o, int argc, char **argv, const bench_v
 #endif
     fprintf(f, "- volume: %s (%u x %u x %u)\n", v->description, v->dims[0], v->dims[1],
             v->dims[2]);
-    fprintf(f, "- view: %ux%u, step %g voxel, no shadows, no shading, early termination 0.99, "
-               "empty-space skipping (camera and transfer function: bench/README.md)\n",
+    fprintf(f, "- view: %ux%u, step %g voxel, no shadows, early termination 0.99, empty-space "
+               "skipping (camera and transfer function: bench/README.md)\n",
             o->width, o->height, o->step);
+    fprintf(f, "- shading: rows without a suffix none; rows `_shaded` gradient Blinn-Phong, kd %g, "
+               "ks %g, shininess %g, ambient 0, one directional white light from +y (VTK: the "
+               "same coefficients and light)\n",
+            shaded->kd, shaded->ks, shaded->shininess);
     fprintf(f, "- medians of %d frames after %d warm-up frames; umbra, native C and VTK take "
-               "turns frame by frame\n\n", o->runs, o->warmup);
+               "turns frame by frame, unshaded and shaded in the same turn\n",
+            o->runs, o->warmup);
+    if (load[0] >= 0.0 && load[1] >= 0.0)
+        fprintf(f, "- load average (1 minute) before / after the frames: %.1f / %.1f (the three "
+                   "renderers use every CPU; a load above that means other processes shared "
+                   "the machine: compare the ratios of one run, not times across runs)\n",
+                load[0], load[1]);
+    fprintf(f, "\n");
     fprintf(f, "| case | ms median | samples/s | samples | ms min | ms max |\n"
                "|---|---:|---:|---:|---:|---:|\n");
-    for (int i = 0; i < nrows; ++i) {
-        if (rows[i].samples)
-            fprintf(f, "| %s | %.1f | %.3g | %llu | %.1f | %.1f |\n", rows[i].name,
-                    rows[i].t.median, (double)rows[i].samples / (rows[i].t.median * 1e-3),
-                    (unsigned long long)rows[i].samples, rows[i].t.min, rows[i].t.max);
+    for (int c = 0; c < ncases; ++c)
+        for (int i = 0; i < cases[c].nrows; ++i) {
+            const row *rw = &cases[c].rows[i];
+            if (rw->samples)
+                fprintf(f, "| %s | %.1f | %.3g | %llu | %.1f | %.1f |\n", rw->name, rw->t.median,
+                        (double)rw->samples / (rw->t.median * 1e-3),
+                        (unsigned long long)rw->samples, rw->t.min, rw->t.max);
+            else
+                fprintf(f, "| %s | %.1f | | | %.1f | %.1f |\n", rw->name, rw->t.median,
+                        rw->t.min, rw->t.max);
+        }
+    fprintf(f, "\n");
+    for (int c = 0; c < ncases; ++c) {
+        const bench_case *bc = &cases[c];
+        const char *what = bc->shading ? "shaded" : "unshaded";
+        fprintf(f, "%s: umbra / native C samples per second **%.2f** (target >= 0.9)", what,
+                bc->ratio);
+        if (bc->vtk_ratio > 0.0)
+            fprintf(f, "; VTK / umbra time per frame **%.2f** (target %s)", bc->vtk_ratio,
+                    bc->shading ? ">= 1.0" : ">= 1.2");
+        if (bc->samples_umbra == bc->samples_native)
+            fprintf(f, "; samples identical (%llu)", (unsigned long long)bc->samples_umbra);
         else
-            fprintf(f, "| %s | %.1f | | | %.1f | %.1f |\n", rows[i].name, rows[i].t.median,
-                    rows[i].t.min, rows[i].t.max);
+            fprintf(f, "; samples %llu vs %llu (float rounding at brick faces and ray ends)",
+                    (unsigned long long)bc->samples_umbra,
+                    (unsigned long long)bc->samples_native);
+        fprintf(f, "; largest pixel difference umbra vs native C %.2e", bc->diff);
+        if (bc->diff_six >= 0.0)
+            fprintf(f, ", vs the C twin shading as before issue #12 (six-sample gradient, powf) "
+                       "%.2e", bc->diff_six);
+        fprintf(f, ".\n\n");
     }
-    fprintf(f, "\numbra / native C samples per second: **%.2f** (target >= 0.9).\n", ratio);
-    if (vtk_ratio > 0.0)
-        fprintf(f, "VTK / umbra time per frame: **%.2f** (target > 1: umbra faster).\n",
-                vtk_ratio);
-    fprintf(f, "umbra vs native C: samples %s; largest pixel difference %.2e.\n",
-            samples_equal, image_diff);
     fclose(f);
     fprintf(stderr, "wrote %s/raycast.csv and %s/raycast.md\n", o->results, o->results);
 }
@@ -425,6 +499,149 @@ static int umbra_frame(umbra_context ctx, umbra_renderer r, const options *o, fl
     return 0;
 }
 
+/* Sets up one case's umbra renderer and native-C twin; 0 on success. */
+static int case_setup(umbra_context ctx, const options *o, bench_volume *vol,
+                      umbra_transfer_function tf, const umbra_camera *cam,
+                      const umbra_light *light, const umbra_render_desc *ro,
+                      const umbra_shadow_desc *sh, bench_case *bc)
+{
+    size_t npix = (size_t)o->width * o->height;
+    bc->img_umbra = malloc(npix * 4 * sizeof(float));
+    bc->img_native = malloc(npix * 4 * sizeof(float));
+    bc->t_dev = malloc((size_t)o->runs * sizeof(double));
+    bc->t_wall = malloc((size_t)o->runs * sizeof(double));
+    bc->t_native = malloc((size_t)o->runs * sizeof(double));
+    bc->t_vtk = malloc((size_t)o->runs * sizeof(double));
+    if (!bc->img_umbra || !bc->img_native || !bc->t_dev || !bc->t_wall || !bc->t_native ||
+        !bc->t_vtk) {
+        fprintf(stderr, "umbra-bench raycast: out of memory\n");
+        return -1;
+    }
+    if (umbra_renderer_create(ctx, &bc->r) != UMBRA_SUCCESS ||
+        umbra_renderer_set_volume(bc->r, vol->volume) != UMBRA_SUCCESS ||
+        umbra_renderer_set_transfer_function(bc->r, tf) != UMBRA_SUCCESS ||
+        umbra_renderer_set_camera(bc->r, cam) != UMBRA_SUCCESS ||
+        umbra_renderer_set_light(bc->r, light) != UMBRA_SUCCESS ||
+        umbra_renderer_set_options(bc->r, ro) != UMBRA_SUCCESS ||
+        umbra_renderer_set_shadow(bc->r, sh) != UMBRA_SUCCESS) {
+        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
+        return -1;
+    }
+    /* native C, on the very same normalised voxels, table and view */
+    cpu_scene *cs = &bc->cs;
+    memset(cs, 0, sizeof *cs);
+    cs->voxels = vol->voxels;
+    for (int a = 0; a < 3; ++a) {
+        cs->dims[a] = (int)vol->dims[a];
+        cs->spacing[a] = vol->spacing[a];
+    }
+    cs->tf = umbra_transfer_function_data(tf);
+    cs->tf_count = (int)umbra_transfer_function_size(tf);
+    cs->camera = *cam;
+    cs->light = *light;
+    cs->opts = *ro;
+    cs->shadow = UMBRA_SHADOW_NONE;
+    cs->reference_step = sh->reference_step;
+    umbra_volume_info info;
+    umbra_volume_get_info(vol->volume, &info);
+    cs->brick_size = (int)info.brick_size;
+    bc->prepared = cpu_prepare(cs);
+    if (!bc->prepared) {
+        fprintf(stderr, "umbra-bench raycast: out of memory in cpu_prepare\n");
+        return -1;
+    }
+    return 0;
+}
+
+static void case_free(bench_case *bc)
+{
+    cpu_prepared_free(bc->prepared);
+    umbra_renderer_release(bc->r);
+    free(bc->img_umbra);
+    free(bc->img_native);
+    free(bc->t_dev);
+    free(bc->t_wall);
+    free(bc->t_native);
+    free(bc->t_vtk);
+}
+
+/* The shaded case's image against the C twin shading as before issue #12 (untimed): what the
+ * faster gradient and specular power changed, on this volume. 0 on success. */
+static int six_sample_diff(const bench_case *bc, const options *o, double *diff)
+{
+    size_t npix = (size_t)o->width * o->height;
+    cpu_scene cs = bc->cs;
+    cs.six_sample_shading = 1;
+    float *img = malloc(npix * 4 * sizeof(float));
+    cpu_prepared *prep = cpu_prepare(&cs);
+    if (!img || !prep) {
+        fprintf(stderr, "umbra-bench raycast: out of memory\n");
+        free(img);
+        cpu_prepared_free(prep);
+        return -1;
+    }
+    cpu_render_prepared(prep, o->width, o->height, img);
+    *diff = 0.0;
+    for (size_t i = 0; i < npix * 4; ++i) {
+        double d = fabs((double)bc->img_umbra[i] - (double)img[i]);
+        *diff = d > *diff ? d : *diff;
+    }
+    cpu_prepared_free(prep);
+    free(img);
+    return 0;
+}
+
+/* The row names of a case: base name plus the case's suffix, in static storage per case. */
+static const char *row_name(char (*names)[40], int slot, const char *base, const char *suffix)
+{
+    snprintf(names[slot], sizeof names[slot], "%s%s", base, suffix);
+    return names[slot];
+}
+
+/* Fills a case's rows and ratios after its timed frames, and reports them on stderr. */
+static void case_report(bench_case *bc, const options *o, int vtk_ran, char (*names)[40])
+{
+    size_t npix = (size_t)o->width * o->height;
+    bc->diff = 0.0;
+    for (size_t i = 0; i < npix * 4; ++i) {
+        double d = fabs((double)bc->img_umbra[i] - (double)bc->img_native[i]);
+        bc->diff = d > bc->diff ? d : bc->diff;
+    }
+    const char *sfx = bc->suffix;
+    bc->nrows = 0;
+    bc->rows[bc->nrows++] = (row){row_name(names, 0, "umbra", sfx),
+                                  bench_timing_of(bc->t_dev, o->runs), bc->samples_umbra};
+    bc->rows[bc->nrows++] = (row){row_name(names, 1, "umbra_wall", sfx),
+                                  bench_timing_of(bc->t_wall, o->runs), bc->samples_umbra};
+    bc->rows[bc->nrows++] = (row){row_name(names, 2, "native_c", sfx),
+                                  bench_timing_of(bc->t_native, o->runs), bc->samples_native};
+    bc->vtk_ratio = 0.0;
+    if (vtk_ran) {
+        bc->rows[bc->nrows++] = (row){row_name(names, 3, "vtk_fixedpoint", sfx),
+                                      bench_timing_of(bc->t_vtk, o->runs), 0};
+        bc->vtk_ratio = bc->rows[3].t.median / bc->rows[0].t.median;
+    }
+    double sps_umbra = (double)bc->samples_umbra / bc->rows[0].t.median;
+    double sps_native = (double)bc->samples_native / bc->rows[2].t.median;
+    bc->ratio = sps_umbra / sps_native;
+    const char *what = bc->shading ? "shaded" : "unshaded";
+    if (bc->diff_six >= 0.0)
+        fprintf(stderr, "shaded: umbra vs the C twin shading as before issue #12 (six-sample "
+                        "gradient, powf): largest pixel difference %.2e\n", bc->diff_six);
+    /* Both take the same samples up to float rounding: a last-bit difference in a ray's
+     * direction (OpenCL's normalize() against the C twin's 1/sqrtf) can move a sample across a
+     * brick face or the ray's end, so a few rays in a million take one sample more or less. */
+    fprintf(stderr, "%s: umbra vs native C: samples %llu vs %llu (%+.1e relative), largest pixel "
+                    "difference %.2e\n",
+            what, (unsigned long long)bc->samples_umbra, (unsigned long long)bc->samples_native,
+            ((double)bc->samples_umbra - (double)bc->samples_native) / (double)bc->samples_native,
+            bc->diff);
+    fprintf(stderr, "%s: ratio umbra/native_c samples/s: %.3f (target >= 0.9)\n", what, bc->ratio);
+    if (bc->vtk_ratio > 0.0)
+        fprintf(stderr, "%s: ratio vtk_fixedpoint/umbra ms per frame: %.3f (target %s)\n", what,
+                bc->vtk_ratio, bc->shading ? ">= 1.0" : ">= 1.2");
+}
+
 int bench_raycast(int argc, char **argv)
 {
     options o;
@@ -436,25 +653,16 @@ int bench_raycast(int argc, char **argv)
         return 1;
     bench_volume vol;
     umbra_transfer_function tf = NULL;
-    umbra_renderer r = NULL;
-    cpu_prepared *prepared = NULL;
+    bench_case cases[2];
+    int ncases = 0;
+    memset(cases, 0, sizeof cases);
     vtk_peer peer = {-1, NULL, NULL};
     int vtk_running = 0;
-    size_t npix = (size_t)o.width * o.height;
-    float *img_umbra = malloc(npix * 4 * sizeof(float));
-    float *img_native = malloc(npix * 4 * sizeof(float));
-    double *t_dev = malloc((size_t)o.runs * sizeof(double));
-    double *t_wall = malloc((size_t)o.runs * sizeof(double));
-    double *t_native = malloc((size_t)o.runs * sizeof(double));
-    double *t_vtk = malloc((size_t)o.runs * sizeof(double));
     char device[700];
+    char names[2][4][40];
     bench_device_description(ctx, device, sizeof device);
     if (bench_volume_load_bonsai(ctx, o.volume, o.procedural, &vol) != 0)
         goto done;
-    if (!img_umbra || !img_native || !t_dev || !t_wall || !t_native || !t_vtk) {
-        fprintf(stderr, "umbra-bench raycast: out of memory\n");
-        goto done;
-    }
     fprintf(stderr, "device: %s\n", device);
 
     umbra_camera cam = bench_camera(&vol);
@@ -467,55 +675,38 @@ int bench_raycast(int argc, char **argv)
     umbra_render_desc_init(&ro);
     ro.step = o.step;
     ro.ambient[0] = ro.ambient[1] = ro.ambient[2] = 0.0f;
+    umbra_render_desc ro_shaded = ro;
+    ro_shaded.shading = 1; /* kd, ks, shininess: the defaults */
     umbra_shadow_desc sh;
     umbra_shadow_desc_init(&sh);
     sh.technique = UMBRA_SHADOW_NONE;
     if (umbra_transfer_function_create_from_points(ctx, bonsai_tf,
                                                    sizeof bonsai_tf / sizeof bonsai_tf[0],
-                                                   TF_RESOLUTION, &tf) != UMBRA_SUCCESS ||
-        umbra_renderer_create(ctx, &r) != UMBRA_SUCCESS ||
-        umbra_renderer_set_volume(r, vol.volume) != UMBRA_SUCCESS ||
-        umbra_renderer_set_transfer_function(r, tf) != UMBRA_SUCCESS ||
-        umbra_renderer_set_camera(r, &cam) != UMBRA_SUCCESS ||
-        umbra_renderer_set_light(r, &light) != UMBRA_SUCCESS ||
-        umbra_renderer_set_options(r, &ro) != UMBRA_SUCCESS ||
-        umbra_renderer_set_shadow(r, &sh) != UMBRA_SUCCESS) {
+                                                   TF_RESOLUTION, &tf) != UMBRA_SUCCESS) {
         fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
         goto done;
     }
-
-    /* native C, on the very same normalised voxels, table and view */
-    cpu_scene cs;
-    memset(&cs, 0, sizeof cs);
-    cs.voxels = vol.voxels;
-    for (int a = 0; a < 3; ++a) {
-        cs.dims[a] = (int)vol.dims[a];
-        cs.spacing[a] = vol.spacing[a];
+    if (o.shading != 1) {
+        cases[ncases].shading = 0;
+        cases[ncases].suffix = "";
+        if (case_setup(ctx, &o, &vol, tf, &cam, &light, &ro, &sh, &cases[ncases++]) != 0)
+            goto done;
     }
-    cs.tf = umbra_transfer_function_data(tf);
-    cs.tf_count = (int)umbra_transfer_function_size(tf);
-    cs.camera = cam;
-    cs.light = light;
-    cs.opts = ro;
-    cs.shadow = UMBRA_SHADOW_NONE;
-    cs.reference_step = sh.reference_step;
-    umbra_volume_info info;
-    umbra_volume_get_info(vol.volume, &info);
-    cs.brick_size = (int)info.brick_size;
-    double tp = bench_now_ms();
-    prepared = cpu_prepare(&cs);
-    tp = bench_now_ms() - tp;
-    if (!prepared) {
-        fprintf(stderr, "umbra-bench raycast: out of memory in cpu_prepare\n");
-        goto done;
+    if (o.shading != 0) {
+        cases[ncases].shading = 1;
+        cases[ncases].suffix = "_shaded";
+        if (case_setup(ctx, &o, &vol, tf, &cam, &light, &ro_shaded, &sh, &cases[ncases++]) != 0)
+            goto done;
     }
 
-    /* VTK in its own process, set up and warmed up before the timed frames. */
+    /* VTK in its own process, set up and warmed up (with and without shading, so that its
+     * gradient encoding is done) before the timed frames. */
     if (o.vtk) {
         char why[256];
         float voxel = fminf(vol.spacing[0], fminf(vol.spacing[1], vol.spacing[2]));
         signal(SIGPIPE, SIG_IGN); /* a peer that dies shows as a failed write, not a signal */
-        if (vtk_start(&o, &vol, &cam, o.step * voxel, &peer, why, sizeof why) == 0)
+        if (vtk_start(&o, &vol, &cam, &ro_shaded, &light, o.step * voxel, &peer, why,
+                      sizeof why) == 0)
             vtk_running = 1;
         else
             fprintf(stderr, "vtk_fixedpoint: skipped: %s\n", why);
@@ -523,95 +714,69 @@ int bench_raycast(int argc, char **argv)
             vtk_stop(&peer);
     }
 
-    /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, so
-     * that a change in the machine's load (other processes) during the measurement touches all
-     * alike. */
-    uint64_t samples_umbra = 0, samples_native = 0;
-    double dev, wall;
-    for (int i = 0; i < o.warmup; ++i) {
-        if (umbra_frame(ctx, r, &o, img_umbra, &dev, &wall, &samples_umbra) != 0)
-            goto done;
-        samples_native = cpu_render_prepared(prepared, o.width, o.height, img_native);
-    }
-    for (int i = 0; i < o.runs; ++i) {
-        if (umbra_frame(ctx, r, &o, img_umbra, &t_dev[i], &t_wall[i], &samples_umbra) != 0)
-            goto done;
-        double t0 = bench_now_ms();
-        samples_native = cpu_render_prepared(prepared, o.width, o.height, img_native);
-        t_native[i] = bench_now_ms() - t0;
-        if (vtk_running && (t_vtk[i] = vtk_frame(&peer)) < 0.0) {
-            fprintf(stderr, "vtk_fixedpoint: dropped: bench/vtk_raycast.py stopped answering\n");
-            vtk_stop(&peer);
-            vtk_running = 0;
+    /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, both
+     * cases in each turn, so that a change in the machine's load (other processes) during the
+     * measurement touches all alike. */
+    double dev, wall, load[2];
+    load[0] = load_average();
+    for (int i = 0; i < o.warmup; ++i)
+        for (int c = 0; c < ncases; ++c) {
+            bench_case *bc = &cases[c];
+            if (umbra_frame(ctx, bc->r, &o, bc->img_umbra, &dev, &wall, &bc->samples_umbra) != 0)
+                goto done;
+            bc->samples_native = cpu_render_prepared(bc->prepared, o.width, o.height,
+                                                     bc->img_native);
         }
-    }
+    for (int i = 0; i < o.runs; ++i)
+        for (int c = 0; c < ncases; ++c) {
+            bench_case *bc = &cases[c];
+            if (umbra_frame(ctx, bc->r, &o, bc->img_umbra, &bc->t_dev[i], &bc->t_wall[i],
+                            &bc->samples_umbra) != 0)
+                goto done;
+            double t0 = bench_now_ms();
+            bc->samples_native = cpu_render_prepared(bc->prepared, o.width, o.height,
+                                                     bc->img_native);
+            bc->t_native[i] = bench_now_ms() - t0;
+            if (vtk_running && (bc->t_vtk[i] = vtk_frame(&peer, bc->shading)) < 0.0) {
+                fprintf(stderr, "vtk_fixedpoint: dropped: bench/vtk_raycast.py stopped answering\n");
+                vtk_stop(&peer);
+                vtk_running = 0;
+            }
+        }
+    load[1] = load_average();
     if (vtk_running && vtk_stop(&peer) != 0)
         fprintf(stderr, "vtk_fixedpoint: bench/vtk_raycast.py exited with an error\n");
 
-    double diff = 0.0;
-    for (size_t i = 0; i < npix * 4; ++i) {
-        double d = fabs((double)img_umbra[i] - (double)img_native[i]);
-        diff = d > diff ? d : diff;
-    }
-    fprintf(stderr, "native C: preparation (tables, bricks; not timed) %.1f ms", tp);
-#ifdef _OPENMP
-    fprintf(stderr, ", %d OpenMP threads", omp_get_max_threads());
-#endif
-    /* Both take the same samples up to float rounding: a last-bit difference in a ray's
-     * direction (OpenCL's normalize() against the C twin's 1/sqrtf) can move a sample across a
-     * brick face or the ray's end, so a few rays in a million take one sample more or less. */
-    fprintf(stderr, "\numbra vs native C: samples %llu vs %llu (%+.1e relative), largest pixel "
-                    "difference %.2e\n",
-            (unsigned long long)samples_umbra, (unsigned long long)samples_native,
-            ((double)samples_umbra - (double)samples_native) / (double)samples_native, diff);
-
-    row rows[4];
-    int nrows = 0;
-    rows[nrows++] = (row){"umbra", bench_timing_of(t_dev, o.runs), samples_umbra};
-    rows[nrows++] = (row){"umbra_wall", bench_timing_of(t_wall, o.runs), samples_umbra};
-    rows[nrows++] = (row){"native_c", bench_timing_of(t_native, o.runs), samples_native};
-    double vtk_ratio = 0.0;
-    if (vtk_running) {
-        rows[nrows++] = (row){"vtk_fixedpoint", bench_timing_of(t_vtk, o.runs), 0};
-        vtk_ratio = rows[3].t.median / rows[0].t.median;
+    for (int c = 0; c < ncases; ++c) {
+        cases[c].diff_six = -1.0;
+        if (cases[c].shading && six_sample_diff(&cases[c], &o, &cases[c].diff_six) != 0)
+            goto done;
+        case_report(&cases[c], &o, vtk_running, names[c]);
     }
     printf("%s\n", BENCH_CSV_HEADER);
-    for (int i = 0; i < nrows; ++i)
-        bench_csv_row(stdout, rows[i].name, rows[i].t, rows[i].samples);
+    for (int c = 0; c < ncases; ++c)
+        for (int i = 0; i < cases[c].nrows; ++i)
+            bench_csv_row(stdout, cases[c].rows[i].name, cases[c].rows[i].t,
+                          cases[c].rows[i].samples);
     fflush(stdout);
-    double sps_umbra = (double)samples_umbra / rows[0].t.median;
-    double sps_native = (double)samples_native / rows[2].t.median;
-    double ratio = sps_umbra / sps_native;
-    fprintf(stderr, "ratio umbra/native_c samples/s: %.3f (target >= 0.9)\n", ratio);
-    if (vtk_ratio > 0.0)
-        fprintf(stderr, "ratio vtk_fixedpoint/umbra ms per frame: %.3f (target > 1)\n", vtk_ratio);
-    if (o.save) {
-        save_png(ctx, o.save, "umbra", o.width, o.height, img_umbra);
-        save_png(ctx, o.save, "native_c", o.width, o.height, img_native);
-    }
-    if (o.results) {
-        char same[160];
-        if (samples_umbra == samples_native)
-            snprintf(same, sizeof same, "identical (%llu)", (unsigned long long)samples_umbra);
-        else
-            snprintf(same, sizeof same, "%llu vs %llu (float rounding at brick faces and ray ends)",
-                     (unsigned long long)samples_umbra, (unsigned long long)samples_native);
-        write_results(&o, argc, argv, &vol, device, rows, nrows, ratio, vtk_ratio, diff, same);
-    }
+    if (o.save)
+        for (int c = 0; c < ncases; ++c) {
+            char n_umbra[40], n_native[40];
+            snprintf(n_umbra, sizeof n_umbra, "umbra%s", cases[c].suffix);
+            snprintf(n_native, sizeof n_native, "native_c%s", cases[c].suffix);
+            save_png(ctx, o.save, n_umbra, o.width, o.height, cases[c].img_umbra);
+            save_png(ctx, o.save, n_native, o.width, o.height, cases[c].img_native);
+        }
+    if (o.results)
+        write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded, load);
     status = 0;
 done:
     if (vtk_running)
         vtk_stop(&peer);
-    cpu_prepared_free(prepared);
-    umbra_renderer_release(r);
+    for (int c = 0; c < 2; ++c)
+        case_free(&cases[c]);
     umbra_transfer_function_release(tf);
     bench_volume_free(&vol);
     umbra_context_release(ctx);
-    free(img_umbra);
-    free(img_native);
-    free(t_dev);
-    free(t_wall);
-    free(t_native);
-    free(t_vtk);
     return status;
 }

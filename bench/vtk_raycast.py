@@ -4,15 +4,19 @@
 
 umbra-bench runs this script with the volume, camera, transfer function and sample distance it
 gives umbra, with --serve: after set-up and the warm-up frames it prints "ready", then renders one
-frame for each line "frame" it reads on stdin and answers "ms <milliseconds>", so umbra-bench can
-interleave VTK's frames with its own and a change in the machine's load touches all alike. Run by
+frame for each line "frame" (unshaded) or "frame shaded" it reads on stdin and answers
+"ms <milliseconds>", so umbra-bench can interleave VTK's frames with its own and a change in the
+machine's load touches all alike. Run by
 hand (without --serve) it renders --runs frames and prints one line:
 
     vtk_fixedpoint <ms_median> <ms_min> <ms_max>
 
 Timed is vtkRenderWindow.Render() of an off-screen window holding one vtkVolume drawn by
-vtkFixedPointVolumeRayCastMapper (all CPU threads, linear interpolation, no shading), after
-warm-up renders: the frame time a VTK user sees. The mapper's own ray-casting time
+vtkFixedPointVolumeRayCastMapper (all CPU threads, linear interpolation; no shading, or with
+--shading KD KS N and a "frame shaded" request its gradient shading: ambient 0, diffuse KD,
+specular KS, specular power N, one directional white light shining along --light, as umbra's),
+after warm-up renders (of both kinds when --shading is given, so that the mapper's encoded
+normals, which it computes once per volume, are ready): the frame time a VTK user sees. The mapper's own ray-casting time
 (GetTimeToDraw) is reported on stderr. The view matches umbra's: the volume's voxel centres are
 placed where umbra puts them (box centred on the origin), the camera is the same look-at
 perspective camera, the sample distance is the same world step with automatic adjustment off and
@@ -29,7 +33,7 @@ import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the mapper's image d
 from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
 from vtkmodules.vtkImagingCore import vtkImageChangeInformation
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGWriter
-from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer,
+from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkLight, vtkRenderer,
                                          vtkRenderWindow, vtkVolume, vtkVolumeProperty,
                                          vtkWindowToImageFilter)
 from vtkmodules.vtkRenderingVolume import vtkFixedPointVolumeRayCastMapper
@@ -51,6 +55,11 @@ def main():
     ap.add_argument("--runs", type=int, default=7)
     ap.add_argument("--warmup", type=int, default=2)
     ap.add_argument("--save", help="write the last frame to this PNG")
+    ap.add_argument("--shading", nargs=3, type=float, metavar=("KD", "KS", "N"),
+                    help="Blinn-Phong coefficients for 'frame shaded' requests (and --shade)")
+    ap.add_argument("--light", nargs=3, type=float, default=[0.0, -1.0, 0.0],
+                    help="direction the directional light shines along")
+    ap.add_argument("--shade", action="store_true", help="without --serve: render shaded")
     ap.add_argument("--serve", action="store_true",
                     help="render a frame per 'frame' line on stdin (see above)")
     a = ap.parse_args()
@@ -84,6 +93,12 @@ def main():
     prop.SetScalarOpacityUnitDistance(min(spacing))
     prop.SetInterpolationTypeToLinear()
     prop.ShadeOff()
+    if a.shading:
+        kd, ks, power = a.shading
+        prop.SetAmbient(0.0)
+        prop.SetDiffuse(kd)
+        prop.SetSpecular(ks)
+        prop.SetSpecularPower(power)
 
     mapper = vtkFixedPointVolumeRayCastMapper()
     mapper.SetInputConnection(place.GetOutputPort())
@@ -100,6 +115,16 @@ def main():
     ren = vtkRenderer()
     ren.SetBackground(0.0, 0.0, 0.0)
     ren.AddVolume(volume)
+    # umbra's directional light instead of VTK's default headlight (the cost is the same: the
+    # mapper shades through tables over its encoded normals, rebuilt per frame for any light).
+    ren.AutomaticLightCreationOff()
+    light = vtkLight()
+    light.SetLightTypeToSceneLight()
+    light.SetPositional(False)
+    light.SetPosition(*[-x for x in a.light])
+    light.SetFocalPoint(0.0, 0.0, 0.0)
+    light.SetColor(1.0, 1.0, 1.0)
+    ren.AddLight(light)
     cam = ren.GetActiveCamera()
     cam.SetPosition(*a.eye)
     cam.SetFocalPoint(*a.target)
@@ -112,24 +137,33 @@ def main():
     win.SetSize(a.size[0], a.size[1])
     win.AddRenderer(ren)
 
-    def frame():
+    def frame(shaded=False):
+        if shaded:
+            prop.ShadeOn()
+        else:
+            prop.ShadeOff()
         cam.Modified()  # nothing may be cached between frames
         t0 = time.perf_counter()
         win.Render()
         return (time.perf_counter() - t0) * 1e3
 
     for _ in range(a.warmup):
-        frame()
+        frame(a.shade)
+        if a.serve and a.shading:
+            frame(True)
     wall, cast = [], []
     if a.serve:
         print("ready", flush=True)
-        while sys.stdin.readline().strip() == "frame":
-            wall.append(frame())
+        while True:
+            request = sys.stdin.readline().strip()
+            if request not in ("frame", "frame shaded"):
+                break
+            wall.append(frame(request == "frame shaded"))
             cast.append(mapper.GetTimeToDraw() * 1e3)
             print("ms %.3f" % wall[-1], flush=True)
     else:
         for _ in range(a.runs):
-            wall.append(frame())
+            wall.append(frame(a.shade))
             cast.append(mapper.GetTimeToDraw() * 1e3)
 
     if a.save:

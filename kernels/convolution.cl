@@ -209,7 +209,7 @@ inline void conv_shade(__global const UmbraFrame *F, float3 c, float3 p, float3 
     float3 l = to_light(F, p).xyz;
     float3 hv = normalize(l + view);
     float diff = fabs(dot(n, l));
-    float spec = pow(fabs(dot(n, hv)), F->shininess);
+    float spec = shading_power(fabs(dot(n, hv)), F->shininess);
     *coef = lc * (c * F->kd * diff + F->ks * spec);
 }
 

@@ -17,9 +17,12 @@
 #define UMBRA_COUNT_ADD(p, v) atomic_add((p), (uint)(v))
 #endif
 
-/* Light arriving at a sample of colour c (alpha ignored) with shadow factor s. */
-inline float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, float3 p, float3 view,
-                           float3 grad)
+/* Light arriving at a sample of colour c (alpha ignored) with shadow factor s. l_ray and hv_ray
+ * are the direction to a directional light and the half vector, the same for every sample of a
+ * ray, so the ray computes them once (shade_ray_light); a point light's are taken at p. The
+ * normal is the gradient times one reciprocal length, as in the C twin. */
+UMBRA_INLINE float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, float3 p,
+                                 float3 view, float3 grad, float3 l_ray, float3 hv_ray)
 {
     float3 light = F3(F->light_color) * s;
     float3 amb = F3(F->ambient);
@@ -28,12 +31,22 @@ inline float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 s, flo
     float gl = length(grad);
     if (!(gl > 1e-6f))
         return c * (amb + light);
-    float3 n = -grad / gl;
-    float3 l = to_light(F, p).xyz;
-    float3 hv = normalize(l + view);
+    float3 n = grad * (-1.0f / gl);
+    float3 l = l_ray, hv = hv_ray;
+    if (F->flags & UMBRA_FLAG_POINT_LIGHT) {
+        l = to_light(F, p).xyz;
+        hv = normalize(l + view);
+    }
     float diff = fabs(dot(n, l));
-    float spec = pow(fabs(dot(n, hv)), F->shininess);
+    float spec = shading_power(fabs(dot(n, hv)), F->shininess);
     return c * (amb + light * F->kd * diff) + light * F->ks * spec;
+}
+
+/* A directional light's direction and half vector for a ray of direction d (shade_sample). */
+inline void shade_ray_light(__global const UmbraFrame *F, float3 d, float3 *l, float3 *hv)
+{
+    *l = -F3(F->light);
+    *hv = normalize(*l - d);
 }
 
 /* The mean depth of the emission along a segment of opacity a, in units of its length, from its
@@ -109,6 +122,9 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
     uint taken = 0;
     ShadowRay sr;
     shadow_ray_init(&sr);
+    float3 l_ray = (float3)(0.0f), hv_ray = (float3)(0.0f);
+    if ((flags & UMBRA_FLAG_SHADING) && !(flags & UMBRA_FLAG_POINT_LIGHT))
+        shade_ray_light(F, d, &l_ray, &hv_ray);
     float2 tb = ray_box(o, d, g.box_min, g.box_max);
     float t0 = fmax(tb.x, 0.0f);
     float t1 = fmin(tb.y, t_ground);
@@ -172,7 +188,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                                                          : shadow_point(p, d, h, c.w));
                 float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p)
                                                             : (float3)(0.0f);
-                float3 lit = shade_sample(F, c.xyz, s, p, -d, grad);
+                float3 lit = shade_sample(F, c.xyz, s, p, -d, grad, l_ray, hv_ray);
                 color += (1.0f - alpha) * c.w * lit;
                 alpha += (1.0f - alpha) * c.w;
                 if (alpha > termination)

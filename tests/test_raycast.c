@@ -7,6 +7,9 @@
  *  - the OpenCL ray caster matches the plain-C twin in tests/reference/cpu_reference.c pixel for
  *    pixel (<= 1e-4 per channel; with the exact reference's adaptive shadow rays <= 1e-3, and
  *    at most 0.5% of values over 1e-4) and sample for sample;
+ *  - gradient shading's faster form (one 32-voxel stencil, binary powering) changes the image
+ *    by at most 1e-4 against the form before it (six trilinear samples, pow), on a noisy uint8
+ *    volume with flat runs and anisotropic spacing too;
  *  - empty-space skipping changes no pixel and takes fewer samples, also on the sub-cell walk's
  *    edge cases (odd brick sizes, rays running in cell faces);
  *  - an application's own cl_context / device / queue work and are left as they were found;
@@ -431,6 +434,123 @@ static void test_raycast_matches_cpu_reference(void **state)
                      over);
         assert_true(stats.samples > 0);
         assert_int_equal(stats.samples, samples);
+        free(voxels);
+        umbra_renderer_release(r);
+        umbra_scene_release(&sc);
+    }
+    free(gpu);
+    free(cpu);
+}
+
+/* ---- the faster shading path (issue #12) --------------------------------------------------------- */
+
+/* A uint8 volume of nx x ny x nz voxels: smooth blobs plus a hash's noise, quantised to 8 bits
+ * like a CT scan, so that gradients point every way, vanish in flat runs and change at the
+ * border voxels (which the camera sees). */
+static umbra_volume make_noisy_uint8_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    size_t n = (size_t)nx * ny * nz;
+    uint8_t *data = malloc(n);
+    assert_non_null(data);
+    uint32_t seed = 12345u;
+    for (uint32_t z = 0; z < nz; ++z)
+        for (uint32_t y = 0; y < ny; ++y)
+            for (uint32_t x = 0; x < nx; ++x) {
+                double v = 0.5 + 0.3 * sin(0.45 * x) * cos(0.35 * y + 0.2 * z) +
+                           0.15 * (next_uniform(&seed) - 0.5);
+                if (x > nx / 2 && y < ny / 3)
+                    v = 0.6; /* a flat run: zero gradients */
+                v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
+                data[((size_t)z * ny + y) * nx + x] = (uint8_t)lrint(v * 255.0);
+            }
+    umbra_volume_desc d;
+    umbra_volume_desc_init(&d);
+    d.data = data;
+    d.type = UMBRA_UINT8;
+    d.dims[0] = nx;
+    d.dims[1] = ny;
+    d.dims[2] = nz;
+    d.spacing[0] = 1.0f;
+    d.spacing[1] = 0.8f;
+    d.spacing[2] = 1.25f;
+    d.value_range_given = 1;
+    d.value_min = 0.0f;
+    d.value_max = 255.0f;
+    d.brick_size = 8;
+    umbra_volume v = NULL;
+    umbra_status st = umbra_volume_create(ctx, &d, &v);
+    free(data);
+    assert_int_equal(st, UMBRA_SUCCESS);
+    return v;
+}
+
+/* Gradient shading as umbra takes it since issue #12 (the gradient from the 32 voxels of one
+ * stencil, the specular power by binary powering: kernels/sampling.cl, kernels/common.cl)
+ * against the form before it (six trilinear samples, pow), as the C twin still computes it on
+ * request: the image may change only by float rounding, at most SHADING_BOUND per channel. The
+ * two gradients are the same sum, rounded differently (cancellation of two interpolated values
+ * before, of voxel values now); where the gradient is a few 1e-6, near the threshold below
+ * which a sample is lit unshaded, that rounding turns its normal, so the bound is on the image,
+ * not on the normal. */
+#define SHADING_BOUND 1e-4
+static void test_shading_matches_six_sample_form(void **state)
+{
+    umbra_context ctx = *state;
+    float *gpu = malloc(RC_W * RC_H * 4 * sizeof *gpu);
+    float *cpu = malloc(RC_W * RC_H * 4 * sizeof *cpu);
+    assert_non_null(gpu);
+    assert_non_null(cpu);
+    for (int i = 0; i < 3; ++i) {
+        umbra_scene sc;
+        memset(&sc, 0, sizeof sc);
+        const char *name = i == 0 ? "spheres" : i == 1 ? "marschner-lobb" : "noisy uint8";
+        if (i < 2) {
+            assert_int_equal(umbra_scene_create(ctx, name, i == 0 ? 48 : 32, &sc), UMBRA_SUCCESS);
+        } else {
+            static const umbra_tf_point ramp[] = {{0.0f, {0.2f, 0.5f, 0.9f, 0.0f}},
+                                                  {0.45f, {0.2f, 0.5f, 0.9f, 0.0f}},
+                                                  {0.6f, {0.9f, 0.6f, 0.3f, 0.3f}},
+                                                  {1.0f, {1.0f, 1.0f, 1.0f, 0.9f}}};
+            sc.volume = make_noisy_uint8_volume(ctx, 20, 24, 28);
+            assert_int_equal(umbra_transfer_function_create_from_points(ctx, ramp, 4, 256, &sc.tf),
+                             UMBRA_SUCCESS);
+            umbra_volume_info info;
+            assert_int_equal(umbra_volume_get_info(sc.volume, &info), UMBRA_SUCCESS);
+            const float dir[3] = {1.3f, 0.9f, 1.6f};
+            float diag = sqrtf(info.extent[0] * info.extent[0] + info.extent[1] * info.extent[1] +
+                               info.extent[2] * info.extent[2]);
+            sc.camera = umbra_camera_orbit(dir, diag, 30.0f);
+            sc.light = test_directional_light(-0.3f, -1.0f, -0.5f);
+            umbra_render_desc_init(&sc.options);
+        }
+        umbra_render_desc o = sc.options;
+        o.shading = 1;
+        o.ks = 0.6f;
+        o.shininess = i == 1 ? 7.0f : 32.0f; /* odd and even powers */
+        o.jitter = 1;
+        o.seed = 3u;
+        umbra_shadow_desc sh;
+        umbra_shadow_desc_init(&sh);
+        sh.technique = UMBRA_SHADOW_NONE;
+        umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &sc.camera, &sc.light, &o);
+        assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_render(r, RC_W, RC_H, gpu), UMBRA_SUCCESS);
+        float *voxels = read_voxels(ctx, sc.volume);
+        cpu_scene cs;
+        fill_cpu_scene(&cs, sc.volume, voxels, sc.tf, &sc.camera, &sc.light, &o, &sh);
+        cs.six_sample_shading = 1;
+        cpu_render(&cs, RC_W, RC_H, cpu);
+        size_t at;
+        double err = max_abs_diff(gpu, cpu, RC_W * RC_H * 4, &at);
+        double lit = 0.0; /* the image must be lit and shaded, or the bound says nothing */
+        for (size_t k = 0; k < (size_t)RC_W * RC_H * 4; k += 4)
+            lit = fmax(lit, cpu[k]);
+        print_message("  %-15s: max |diff| %.2e against the six-sample gradient and pow (bound "
+                      "%.0e), brightest red %.2f\n", name, err, SHADING_BOUND, lit);
+        assert_true(lit > 0.2);
+        if (!(err <= SHADING_BOUND))
+            fail_msg("%s: pixel (%zu, %zu) channel %zu: umbra %.7f, six-sample form %.7f", name,
+                     (at / 4) % RC_W, (at / 4) / RC_W, at % 4, gpu[at], cpu[at]);
         free(voxels);
         umbra_renderer_release(r);
         umbra_scene_release(&sc);
@@ -1011,6 +1131,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_reference_slab_matches_exp),
         cmocka_unit_test(test_reference_extreme_opacity_long_path),
         cmocka_unit_test(test_raycast_matches_cpu_reference),
+        cmocka_unit_test(test_shading_matches_six_sample_form),
         cmocka_unit_test(test_empty_space_skipping_changes_no_pixel),
         cmocka_unit_test(test_cell_walk_edge_cases),
         cmocka_unit_test(test_application_context_path),

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/reference/cpu_reference.c: see cpu_reference.h. Plain C99 with OpenMP; every formula is
  * restated here from the documented model rather than shared with the library, so a mistake in
- * one is not silently repeated in the other. */
+ * one is not silently repeated in the other. Why one file past 800 lines: it is one renderer,
+ * read side by side with kernels/raycast.cl and shadow_reference.cl, step for step. */
 #include "cpu_reference.h"
 
 #include <float.h>
@@ -583,13 +584,72 @@ static v3 shadow_factor(const prep *P, v3 p)
     return P->s->shadow == UMBRA_SHADOW_REFERENCE ? shadow(P, p) : mk(1, 1, 1);
 }
 
-static v3 gradient(const prep *P, v3 p)
+/* The gradient before issue #12: six trilinear samples one voxel each way. */
+static v3 gradient_six_samples(const prep *P, v3 p)
 {
     v3 s = P->spacing;
     float gx = sample(P, add(p, mk(s.x, 0, 0))) - sample(P, sub(p, mk(s.x, 0, 0)));
     float gy = sample(P, add(p, mk(0, s.y, 0))) - sample(P, sub(p, mk(0, s.y, 0)));
     float gz = sample(P, add(p, mk(0, 0, s.z))) - sample(P, sub(p, mk(0, 0, s.z)));
     return vmul(mul(mk(gx, gy, gz), 0.5f), P->inv_spacing);
+}
+
+/* x^n as the kernel takes the specular power (kernels/common.cl, shading_power): by binary
+ * powering for a whole n up to 256, within (n - 1) 2^-24 relative of powf, else powf. */
+static float shading_power(float x, float n)
+{
+    if (!(n == floorf(n) && n <= 256.0f))
+        return powf(x, n);
+    unsigned e = (unsigned)n;
+    float r = 1.0f;
+    for (;;) {
+        if (e & 1u)
+            r *= x;
+        e >>= 1;
+        if (!e)
+            return r;
+        x *= x;
+    }
+}
+
+/* The central difference of the trilinear interpolant, (sample(p + e) - sample(p - e)) / 2 per
+ * axis, one voxel e each way, computed as the kernel does (kernels/sampling.cl,
+ * volume_gradient): the voxels' central differences interpolated over p's cell, from the 32
+ * voxels the six samples read, indices clamped one by one. */
+static v3 gradient(const prep *P, v3 p)
+{
+    const cpu_scene *s = P->s;
+    const float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+                        (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+                        (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    size_t idx[3][4]; /* per axis: the offsets of voxels i - 1, i, i + 1, i + 2, clamped */
+    float f[3];
+    const size_t stride[3] = {1, (size_t)s->dims[0], (size_t)s->dims[0] * (size_t)s->dims[1]};
+    for (int a = 0; a < 3; ++a) {
+        float xa = clampf(x[a], -1.0f, (float)s->dims[a]);
+        float fl = floorf(xa);
+        f[a] = xa - fl;
+        for (int k = 0; k < 4; ++k) {
+            int i = (int)fl - 1 + k;
+            i = i < 0 ? 0 : i > s->dims[a] - 1 ? s->dims[a] - 1 : i;
+            idx[a][k] = (size_t)i * stride[a];
+        }
+    }
+    float g[3];
+    for (int a = 0; a < 3; ++a) {
+        /* the other two axes u, v (in increasing order): the cell's 2 x 2 corners across them */
+        const int u = a == 0 ? 1 : 0, v = a == 2 ? 1 : 2;
+        float dcell[2][2];
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) {
+                size_t base = idx[u][1 + j] + idx[v][1 + k];
+                const float *r = s->voxels + base;
+                float d0 = r[idx[a][2]] - r[idx[a][0]], d1 = r[idx[a][3]] - r[idx[a][1]];
+                dcell[j][k] = lerp(d0, d1, f[a]);
+            }
+        g[a] = lerp(lerp(dcell[0][0], dcell[1][0], f[u]), lerp(dcell[0][1], dcell[1][1], f[u]), f[v]);
+    }
+    return vmul(mul(mk(g[0], g[1], g[2]), 0.5f), P->inv_spacing);
 }
 
 static uint32_t hash(uint32_t x)
@@ -703,7 +763,8 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                     v3 light = vmul(from(s->light.color), sf);
                     v3 amb = from(o->ambient);
                     v3 lit;
-                    v3 g = o->shading ? gradient(P, p) : mk(0, 0, 0);
+                    const int six = P->s->six_sample_shading;
+                    v3 g = !o->shading ? mk(0, 0, 0) : six ? gradient_six_samples(P, p) : gradient(P, p);
                     float gl = sqrtf(dot(g, g));
                     if (!o->shading || !(gl > 1e-6f)) {
                         lit = vmul(mk(c[0], c[1], c[2]), add(amb, light));
@@ -713,7 +774,8 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                         v3 l = to_light(P, p, &dist);
                         v3 hv = norm(add(l, mul(d, -1.0f)));
                         float diff = fabsf(dot(nrm, l));
-                        float spec = powf(fabsf(dot(nrm, hv)), o->shininess);
+                        float spec = six ? powf(fabsf(dot(nrm, hv)), o->shininess)
+                                         : shading_power(fabsf(dot(nrm, hv)), o->shininess);
                         lit = add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
                                   mul(light, o->ks * spec));
                     }

@@ -24,6 +24,9 @@ typedef struct cpu_scene {
     umbra_shadow_technique shadow;/* UMBRA_SHADOW_NONE or UMBRA_SHADOW_REFERENCE */
     float reference_step;         /* voxels */
     int brick_size;               /* empty-space skipping bricks (as the volume's) */
+    int six_sample_shading;       /* nonzero: Blinn-Phong as before issue #12, the gradient from
+                                     six trilinear samples and the specular power by powf, for
+                                     tests that bound what the faster form changes */
 } cpu_scene;
 
 /* Renders w x h premultiplied RGBA floats; returns the number of samples taken (samples skipped
