@@ -38,7 +38,7 @@
 #define UMBRA_SOURCE_DIR "."
 #endif
 
-enum { NTECH = 4, MAX_SIZES = 8 };
+enum { NTECH = 4, MAX_SIZES = 5 };
 static const umbra_shadow_technique techs[NTECH] = {UMBRA_SHADOW_NONE, UMBRA_SHADOW_THRESHOLD,
                                                     UMBRA_SHADOW_CSSM, UMBRA_SHADOW_DEEP};
 
@@ -66,6 +66,12 @@ static const char *type_name(umbra_scalar_type t)
 }
 
 static double voxels_of(const uint32_t d[3]) { return (double)d[0] * d[1] * d[2]; }
+
+static int cmp_dims(const void *a, const void *b)
+{
+    double x = voxels_of(a), y = voxels_of(b);
+    return (x > y) - (x < y);
+}
 
 /* ---- the procedural field ------------------------------------------------------------------- */
 
@@ -119,10 +125,10 @@ static int write_field(const char *path, const uint32_t dims[3], umbra_scalar_ty
                     out[i] = (unsigned char)lrintf(v * 255.0f);
                 } else if (type == UMBRA_FLOAT32) {
                     memcpy(out + 4 * i, &v, 4);
-                } else {
-                    long q = lrintf(v * 65535.0f) - (type == UMBRA_INT16 ? 32768 : 0);
-                    uint16_t u = (uint16_t)(type == UMBRA_INT16 ? (uint16_t)(int16_t)q : (uint16_t)q);
-                    memcpy(out + 2 * i, &u, 2); /* host order: umbra_raw_desc says little-endian */
+                } else { /* int16 is x - 32768: the top bit flipped in two's complement */
+                    uint16_t u = (uint16_t)((unsigned long)lrintf(v * 65535.0f) ^
+                                            (type == UMBRA_INT16 ? 0x8000u : 0u));
+                    memcpy(out + 2 * i, &u, 2); /* host order; the child tells the loader */
                 }
             }
         }
@@ -156,8 +162,6 @@ static double proc_bytes(const char *file, const char *key)
     return kib < 0.0 ? -1.0 : kib * 1024.0;
 }
 
-static void median_of(const double *v, int n, double *out) { *out = bench_timing_of(v, n).median; }
-
 /* Loads path, renders, prints "key value" lines to stdout. Returns the exit status. */
 static int child_run(const char *path, const uint32_t dims[3], umbra_scalar_type type,
                      uint32_t w, uint32_t h, int runs, int techmask, const char *device)
@@ -176,6 +180,8 @@ static int child_run(const char *path, const uint32_t dims[3], umbra_scalar_type
     umbra_raw_desc rd;
     umbra_raw_desc_init(&rd);
     rd.type = type;
+    const uint16_t one = 1;
+    rd.big_endian = *(const unsigned char *)&one == 0; /* the file is in host order */
     memcpy(rd.dims, dims, sizeof rd.dims);
     t0 = bench_now_ms();
     if (umbra_volume_load_raw(ctx, path, &rd, &vol) != UMBRA_SUCCESS)
@@ -252,10 +258,8 @@ static int child_run(const char *path, const uint32_t dims[3], umbra_scalar_type
             re[k] = st.render_ms;
             fr[k] = bu[k] + re[k];
         }
-        double f, b, rr;
-        median_of(fr, nr, &f);
-        median_of(bu, nr, &b);
-        median_of(re, nr, &rr);
+        double f = bench_timing_of(fr, nr).median, b = bench_timing_of(bu, nr).median,
+               rr = bench_timing_of(re, nr).median;
         printf("frame_ms.%d %.3f\nbuild_ms.%d %.3f\nrender_ms.%d %.3f\nmap_bytes.%d %zu\n"
                "runs.%d %d\n",
                t, f, t, b, t, rr, t, st.shadow_memory_bytes, t, nr);
@@ -315,12 +319,9 @@ static void parse_line(row *R, char *line)
 /* Runs `umbra-bench scale --child ...` on path and fills R (peak RSS from wait4). */
 static void run_child(const options *o, const char *path, const uint32_t dims[3], row *R)
 {
-    char a[5][16], runs[16], mask[16];
-    snprintf(a[0], 16, "%u", dims[0]);
-    snprintf(a[1], 16, "%u", dims[1]);
-    snprintf(a[2], 16, "%u", dims[2]);
-    snprintf(a[3], 16, "%u", o->width);
-    snprintf(a[4], 16, "%u", o->height);
+    char dims_s[48], image[32], runs[16], mask[16];
+    snprintf(dims_s, sizeof dims_s, "%ux%ux%u", dims[0], dims[1], dims[2]);
+    snprintf(image, sizeof image, "%ux%u", o->width, o->height);
     snprintf(runs, sizeof runs, "%d", o->runs);
     snprintf(mask, sizeof mask, "%d", o->techmask);
     int fd[2];
@@ -334,9 +335,8 @@ static void run_child(const options *o, const char *path, const uint32_t dims[3]
         close(fd[0]);
         dup2(fd[1], STDOUT_FILENO);
         close(fd[1]);
-        execl("/proc/self/exe", "umbra-bench", "scale", "--child", path, a[0], a[1], a[2],
-              type_name(o->type), a[3], a[4], runs, mask, o->device ? o->device : "",
-              (char *)NULL);
+        execl("/proc/self/exe", "umbra-bench", "scale", "--child", path, dims_s, type_name(o->type),
+              image, runs, mask, o->device ? o->device : "", (char *)NULL);
         _exit(127);
     }
     close(fd[1]);
@@ -367,27 +367,14 @@ static void run_child(const options *o, const char *path, const uint32_t dims[3]
         snprintf(R->status, sizeof R->status, "ok");
 }
 
+/* "WxHxD", digits and 'x' only (sscanf alone takes "-1" and blanks), each side in [2, 65536]. */
 static int parse_dims(const char *s, uint32_t d[3])
 {
-    char buf[64];
-    long v[3];
-    if (!s || strlen(s) >= sizeof buf)
+    char tail;
+    if (!s || strspn(s, "0123456789x") != strlen(s) ||
+        sscanf(s, "%ux%ux%u%c", &d[0], &d[1], &d[2], &tail) != 3)
         return -1;
-    strcpy(buf, s);
-    char *p = buf;
-    for (int a = 0; a < 3; ++a) {
-        char *x = strchr(p, 'x');
-        if ((a < 2) != (x != NULL))
-            return -1;
-        if (x)
-            *x = 0;
-        if (bench_parse_int(p, 2, 65536, &v[a]) != 0)
-            return -1;
-        p = x ? x + 1 : p;
-    }
-    for (int a = 0; a < 3; ++a)
-        d[a] = (uint32_t)v[a];
-    return 0;
+    return d[0] < 2 || d[1] < 2 || d[2] < 2 || d[0] > 65536 || d[1] > 65536 || d[2] > 65536 ? -1 : 0;
 }
 
 static void git_commit(char *buf, size_t size)
@@ -495,14 +482,26 @@ static void write_md(FILE *f, const row *rows, int n, const options *o, const ch
         for (int t = 0; t < NTECH; ++t)
             fmt_ms(R->runs[t] > 0.0 ? R->frame_ms[t] : 0.0, c[3 + t], 32);
         bench_format_bytes((size_t)R->peak_rss, c[7], 32);
-        fprintf(f, "| %ux%ux%u | %.3g | %s | %s | %s | %s | %s | %s | %s | %.3g | %s | ",
+        char smp[32] = "–";
+        if (R->samples > 0.0)
+            snprintf(smp, sizeof smp, "%.3g", R->samples);
+        fprintf(f, "| %ux%ux%u | %.3g | %s | %s | %s | %s | %s | %s | %s | %s | %s | ",
                 R->dims[0], R->dims[1], R->dims[2], voxels_of(R->dims), c[0], c[1], c[2], c[3],
-                c[4], c[5], c[6], R->samples, c[7]);
+                c[4], c[5], c[6], smp, R->peak_rss > 0.0 ? c[7] : "–");
         if (R->device_bytes > 0.0)
             fprintf(f, "%.2f |\n", R->device_bytes / voxels_of(R->dims));
         else
             fprintf(f, "– |\n");
     }
+    for (int i = 0; i < n; ++i) /* issue 14's targets on the 2-core 24 GiB machine */
+        if (voxels_of(rows[i].dims) == 1073741824.0 && o->type == UMBRA_UINT8 &&
+            rows[i].first_ms > 0.0)
+            fprintf(f, "\nTargets at 1024³ uint8: peak RSS %.2f GiB (target <= 2.5: %s), time to "
+                       "first frame %.1f s (target <= 4: %s).\n",
+                    rows[i].peak_rss / 1073741824.0, rows[i].peak_rss <= 2.5 * 1073741824.0 ? "met"
+                                                                                     : "not met",
+                    (rows[i].load_ms + rows[i].first_ms) / 1e3,
+                    rows[i].load_ms + rows[i].first_ms <= 4000.0 ? "met" : "not met");
     fprintf(f, "\nNot measured or failed:");
     int any = 0;
     for (int i = 0; i < n; ++i)
@@ -519,33 +518,17 @@ static void write_md(FILE *f, const row *rows, int n, const options *o, const ch
             any ? "" : " nothing");
 }
 
-/* Log-log plot of time and memory against voxels, from the CSV; skipped if gnuplot is absent. */
+/* bench/plot_scale.gp draws DIR/scale.png from DIR/scale.csv; skipped if gnuplot is absent. */
 static void write_plot(const char *dir)
 {
     FILE *gp = popen("gnuplot >/dev/null 2>&1", "w");
-    if (!gp) {
-        fprintf(stderr, "umbra-bench scale: plot skipped: cannot run gnuplot\n");
-        return;
-    }
-    fprintf(gp,
-            "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1200,480 }"
-            " else { set terminal png size 1200,480 }\n"
-            "set output '%s/scale.png'\nset datafile separator ','\nset logscale xy\n"
-            "set grid\nset key top left\nset xlabel 'voxels'\nset multiplot layout 1,2\n"
-            "set ylabel 'ms'\nset title 'time'\n"
-            "plot for [c in '9 12 16 20 24'] '%s/scale.csv' skip 1 using 6:(column(c+0)) "
-            "with linespoints title (c eq '9' ? 'to first frame' : c eq '12' ? 'none frame' : "
-            "c eq '16' ? 'threshold frame' : c eq '20' ? 'cssm frame' : 'deep frame')\n"
-            "set ylabel 'bytes'\nset title 'memory'\n"
-            "plot '%s/scale.csv' skip 1 using 6:28 with linespoints title 'peak host RSS', "
-            "'' skip 1 using 6:30 with linespoints title 'volume device bytes', "
-            "'' skip 1 using 6:6 with lines dt 2 title '1 byte per voxel'\n"
-            "unset multiplot\n",
-            dir, dir, dir);
-    int rc = pclose(gp);
+    if (gp)
+        fprintf(gp, "csv = '%s/scale.csv'\nout = '%s/scale.png'\nload '%s/bench/plot_scale.gp'\n",
+                dir, dir, UMBRA_SOURCE_DIR);
+    int rc = gp ? pclose(gp) : -1;
     if (rc != 0)
-        fprintf(stderr, "umbra-bench scale: plot skipped: gnuplot exited with status %d (Debian: "
-                        "apt-get install gnuplot-nox)\n", rc);
+        fprintf(stderr, "umbra-bench scale: plot skipped: gnuplot failed or is missing (status %d; "
+                        "Debian: apt-get install gnuplot-nox)\n", rc);
 }
 
 static void usage(FILE *f)
@@ -554,16 +537,15 @@ static void usage(FILE *f)
             "usage: umbra-bench scale [options]\n"
             "  Time to first frame, frame times (none, threshold, cssm, deep), peak host memory\n"
             "  and device bytes per voxel for procedural volumes of growing size, each size in a\n"
-            "  fresh process. CSV on stdout.\n"
+            "  fresh process: 128^3, 256^3, 512^3, 1024^3. CSV on stdout. The raw files go to\n"
+            "  $TMPDIR (default /tmp), one at a time.\n"
             "  --quick            128^3 and 256^3, --runs 1 (a minute or two)\n"
             "  --max WxHxD        add a larger size, e.g. 2048x2048x1536\n"
-            "  --sizes N,N,..     cubes to run instead of 128,256,512,1024\n"
             "  --type T           uint8 (default), uint16, int16 or float\n"
             "  --techniques A,B   of none,threshold,cssm,deep (default all)\n"
             "  --size WxH         image size (default 512x512)\n"
             "  --runs N           timed frames per technique after the first (default 3)\n"
             "  --results DIR      also write DIR/scale.csv, DIR/scale.md, DIR/scale.png\n"
-            "  --tmp DIR          where the raw files go (default $TMPDIR or /tmp)\n"
             "  --no-plots         no gnuplot\n"
             "  --device SPEC      OpenCL device (name or P:D)\n");
 }
@@ -590,12 +572,9 @@ static int parse_techniques(const char *s, int *mask)
 
 static int parse_type(const char *s, umbra_scalar_type *t)
 {
-    const umbra_scalar_type all[4] = {UMBRA_UINT8, UMBRA_UINT16, UMBRA_INT16, UMBRA_FLOAT32};
-    for (int k = 0; k < 4; ++k)
-        if (strcmp(s, type_name(all[k])) == 0) {
-            *t = all[k];
-            return 0;
-        }
+    for (int k = UMBRA_UINT8; k <= UMBRA_FLOAT32; ++k)
+        if (strcmp(s, type_name((umbra_scalar_type)k)) == 0)
+            return *t = (umbra_scalar_type)k, 0;
     return -1;
 }
 
@@ -608,25 +587,19 @@ int bench_scale(int argc, char **argv)
     o.techmask = (1 << NTECH) - 1;
     o.width = o.height = 512;
     o.type = UMBRA_UINT8;
-    const char *sizes = "128,256,512,1024", *maxdims = NULL;
-    const char *tmpenv = getenv("TMPDIR");
+    const char *maxdims = NULL, *tmpenv = getenv("TMPDIR");
+    int nsizes = 4;
     o.tmp = tmpenv && *tmpenv ? tmpenv : "/tmp";
 
-    if (argc == 12 && strcmp(argv[1], "--child") == 0) {
+    if (argc == 9 && strcmp(argv[1], "--child") == 0) {
         uint32_t d[3], w, h;
-        long v[6];
+        long runs, mask;
         umbra_scalar_type t;
-        for (int k = 0; k < 6; ++k)
-            if (bench_parse_int(argv[3 + (k < 3 ? k : k + 1)], 0, 1L << 20, &v[k]) != 0)
-                return 2;
-        if (parse_type(argv[6], &t) != 0)
+        if (parse_dims(argv[3], d) != 0 || parse_type(argv[4], &t) != 0 ||
+            bench_parse_size(argv[5], &w, &h) != 0 || bench_parse_int(argv[6], 1, 64, &runs) != 0 ||
+            bench_parse_int(argv[7], 1, 15, &mask) != 0)
             return 2;
-        d[0] = (uint32_t)v[0], d[1] = (uint32_t)v[1], d[2] = (uint32_t)v[2];
-        w = (uint32_t)v[3], h = (uint32_t)v[4];
-        long mask;
-        if (v[5] < 1 || v[5] > 64 || bench_parse_int(argv[10], 1, 15, &mask) != 0)
-            return 2;
-        return child_run(argv[2], d, t, w, h, (int)v[5], (int)mask, argv[11][0] ? argv[11] : NULL);
+        return child_run(argv[2], d, t, w, h, (int)runs, (int)mask, argv[8][0] ? argv[8] : NULL);
     }
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -636,7 +609,7 @@ int bench_scale(int argc, char **argv)
             usage(stdout);
             return 0;
         } else if (strcmp(a, "--quick") == 0) {
-            sizes = "128,256";
+            nsizes = 2;
             o.runs = 1;
             takes = 0;
         } else if (strcmp(a, "--no-plots") == 0) {
@@ -646,8 +619,6 @@ int bench_scale(int argc, char **argv)
             bad = 1;
         } else if (strcmp(a, "--max") == 0) {
             maxdims = v;
-        } else if (strcmp(a, "--sizes") == 0) {
-            sizes = v;
         } else if (strcmp(a, "--type") == 0) {
             bad = parse_type(v, &o.type);
         } else if (strcmp(a, "--techniques") == 0) {
@@ -659,8 +630,6 @@ int bench_scale(int argc, char **argv)
             o.runs = (int)n;
         } else if (strcmp(a, "--results") == 0) {
             o.results = v;
-        } else if (strcmp(a, "--tmp") == 0) {
-            o.tmp = v;
         } else if (strcmp(a, "--device") == 0) {
             o.device = v;
         } else {
@@ -674,22 +643,16 @@ int bench_scale(int argc, char **argv)
         }
         i += takes;
     }
-    char list[256];
-    snprintf(list, sizeof list, "%s", sizes);
-    for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
-        long n;
-        if (o.nsizes >= MAX_SIZES - 1 || bench_parse_int(tok, 2, 65536, &n) != 0) {
-            fprintf(stderr, "umbra-bench scale: bad --sizes %s (at most %d sides of 2..65536)\n",
-                    sizes, MAX_SIZES - 1);
-            return 2;
-        }
-        o.dims[o.nsizes][0] = o.dims[o.nsizes][1] = o.dims[o.nsizes][2] = (uint32_t)n;
-        o.nsizes++;
-    }
+    for (int k = 0; k < nsizes; ++k)
+        o.dims[k][0] = o.dims[k][1] = o.dims[k][2] = 128u << k; /* 128^3 .. 1024^3 */
+    o.nsizes = nsizes;
     if (maxdims && parse_dims(maxdims, o.dims[o.nsizes++]) != 0) {
         fprintf(stderr, "umbra-bench scale: bad --max %s (WxHxD, each 2..65536)\n", maxdims);
         return 2;
     }
+
+    /* Smallest first: each size's checks predict from the ones before. */
+    qsort(o.dims, (size_t)o.nsizes, sizeof o.dims[0], cmp_dims);
 
     /* The machine, then the device's memory for the up-front checks. */
     char machine[256], device[512], commit[64], started[64];
@@ -700,7 +663,8 @@ int bench_scale(int argc, char **argv)
     gmtime_r(&now, &tm);
     strftime(started, sizeof started, "%Y-%m-%d %H:%M UTC", &tm);
     char load_start[64];
-    load_average(load_start, sizeof load_start);    umbra_context ctx = bench_context(o.device);
+    load_average(load_start, sizeof load_start);
+    umbra_context ctx = bench_context(o.device);
     if (!ctx)
         return 1;
     bench_device_description(ctx, device, sizeof device);
