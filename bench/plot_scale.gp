@@ -16,6 +16,7 @@ set xlabel 'voxels'
 set multiplot layout 1,3
 set ylabel 'ms'
 set title 'time (frames: device time of build + render)'
+set key bottom right
 plot csv using 'voxels':'time_to_first_frame_ms' with linespoints title 'to first frame', \
      '' using 'voxels':'none_frame_ms' with linespoints title 'none frame', \
      '' using 'voxels':'threshold_frame_ms' with linespoints title 'threshold frame', \
@@ -23,6 +24,7 @@ plot csv using 'voxels':'time_to_first_frame_ms' with linespoints title 'to firs
      '' using 'voxels':'deep_frame_ms' with linespoints title 'deep frame'
 set ylabel 'bytes'
 set title 'memory'
+set key top left
 plot csv using 'voxels':'peak_rss_bytes' with linespoints title 'peak host RSS', \
      '' using 'voxels':'volume_device_bytes' with linespoints title 'volume device bytes', \
      '' using 'voxels':'voxels' with lines dt 2 title '1 byte per voxel'
