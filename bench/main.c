@@ -16,6 +16,8 @@ static const bench_command commands[] = {
      "every shadow technique vs the exact reference: error, time, memory (CSV, plots)"},
     {"readme", bench_readme,
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
+    {"scale", bench_scale,
+     "time to first frame, frame times and memory against volume size (128^3 .. 1024^3 and up)"},
 };
 
 static void usage(FILE *f)
