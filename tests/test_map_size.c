@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_map_size.c: map_size UMBRA_MAP_SIZE_AUTO, the light-space map resolution chosen from
  * the volume's footprint as the light sees it (include/umbra/renderer.h has the rule):
- *  - a directional light gets the wider side of the box's projection in voxels (the smallest
- *    spacing), rounded up to a multiple of 32: axis-aligned and oblique directions, anisotropic
- *    spacing;
+ *  - a directional light gets k times the wider side of the box's projection in voxels (the
+ *    smallest spacing), k = 1, 3, 2 texels per voxel for threshold, CSSM and deep, rounded up to
+ *    a multiple of 32: axis-aligned and oblique directions, anisotropic spacing;
  *  - a point light outside the box gets its frustum measured at the box centre's distance (more
  *    than the directional size when the light is close); one inside gets the octahedral rule;
  *  - the bounds: a tiny volume gets UMBRA_MAP_SIZE_AUTO_MIN, a long one UMBRA_MAP_SIZE_AUTO_MAX;
@@ -34,6 +34,12 @@ static int teardown(void **state)
     (void)state;
     umbra_context_release(ctx);
     return 0;
+}
+
+/* Texels per voxel of each technique (the header's k). */
+static double k_of(umbra_shadow_technique t)
+{
+    return t == UMBRA_SHADOW_CSSM ? 3.0 : t == UMBRA_SHADOW_DEEP ? 2.0 : 1.0;
 }
 
 /* The rule's rounding and bounds, applied to a texel count n. */
@@ -115,8 +121,15 @@ static void test_auto_directional_follows_the_projected_box(void **state)
     v = make_volume(60, 60, 60, NULL);
     assert_int_equal(built_size(v, test_directional_light(1, 1, 0), UMBRA_SHADOW_CSSM,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
-                     round_bound(60.0 * sqrt(2.0)));
+                     round_bound(k_of(UMBRA_SHADOW_CSSM) * 60.0 * sqrt(2.0)));
+    /* The same light gives each technique its own texels per voxel: 64, 192, 128. */
     assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_CSSM,
+                                UMBRA_MAP_SIZE_AUTO, NULL),
+                     round_bound(3.0 * 60.0));
+    assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_DEEP,
+                                UMBRA_MAP_SIZE_AUTO, NULL),
+                     round_bound(2.0 * 60.0));
+    assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(60.0));
     umbra_volume_release(v);
@@ -127,7 +140,7 @@ static void test_auto_directional_follows_the_projected_box(void **state)
     v = make_volume(64, 64, 64, spacing);
     assert_int_equal(built_size(v, test_directional_light(0, 0, 1), UMBRA_SHADOW_DEEP,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
-                     round_bound(128.0));
+                     round_bound(k_of(UMBRA_SHADOW_DEEP) * 128.0));
     umbra_volume_release(v);
 }
 
@@ -151,11 +164,13 @@ static void test_auto_point_light_frustum_and_inside(void **state)
     /* Inside the box: the octahedral map, sqrt(4 pi) R texels with R the farthest corner. */
     assert_int_equal(built_size(v, test_point_light(10, 0, 0), UMBRA_SHADOW_CSSM,
                                 UMBRA_MAP_SIZE_AUTO, &mode),
-                     round_bound(sqrt(4.0 * 3.14159265358979) * sqrt(40.0 * 40.0 + 2 * 30.0 * 30.0)));
+                     round_bound(k_of(UMBRA_SHADOW_CSSM) * sqrt(4.0 * 3.14159265358979) *
+                                 sqrt(40.0 * 40.0 + 2 * 30.0 * 30.0)));
     assert_int_equal(mode, UMBRA_LS_OCTAHEDRAL);
     assert_int_equal(built_size(v, test_point_light(0, 0, 0), UMBRA_SHADOW_DEEP,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
-                     round_bound(sqrt(4.0 * 3.14159265358979) * sqrt(3.0) * 30.0));
+                     round_bound(k_of(UMBRA_SHADOW_DEEP) * sqrt(4.0 * 3.14159265358979) *
+                                 sqrt(3.0) * 30.0));
     umbra_volume_release(v);
 }
 

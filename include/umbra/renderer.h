@@ -134,19 +134,20 @@ UMBRA_API const char *umbra_shadow_technique_name(umbra_shadow_technique techniq
 /* Parses a name; UMBRA_ERROR_INVALID_ARGUMENT for an unknown one. */
 UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
 
-/* map_size UMBRA_MAP_SIZE_AUTO (the default) lets each build of a light-space map (threshold,
- * deep, CSSM) choose its resolution from the volume's footprint as the light sees it: about one
- * texel per voxel (the smallest spacing) across the box's projection, since finer maps only
- * sample the same voxels again (on the walnut every technique's error is flat from 512^2 to
- * 4096^2). A directional light's orthographic map gets the wider side of the box's projection
- * in voxels; a point light's frustum the same measured at the distance of the box's centre (the
- * near side gets more than one texel per voxel, the far side less); a point light inside or
- * near the box (octahedral map over every direction) sqrt(4 pi) R / voxel, R the distance to the
- * farthest corner, one texel per voxel at that distance. The result is rounded up to a multiple
- * of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN,
- * UMBRA_MAP_SIZE_AUTO_MAX]. The size is chosen again when the light or volume changes (which
- * rebuilds the map anyway); umbra_render_stats.map_size says what was chosen. CSSM's taps are
- * fixed in texels, so their blur radius follows the chosen size. */
+/* map_size UMBRA_MAP_SIZE_AUTO (the default) lets each build of a light-space map choose its
+ * resolution from the volume's footprint as the light sees it: k texels per voxel (the smallest
+ * spacing) across the box's projection, k = 1 for the threshold map (one depth per texel: finer
+ * maps sample the same voxels again), 3 for CSSM (its taps are fixed in texels, radius 4 for 13
+ * taps, so fewer texels per voxel blur the shadow over several voxels) and 2 for the deep map
+ * (nearest-texel lookup: its error keeps falling with the size; README, "Map size"). A
+ * directional light's orthographic map gets k times the wider side of the box's projection in
+ * voxels; a point light's frustum the same measured at the distance of the box's centre (the near
+ * side gets more texels per voxel, the far side fewer); a point light inside or near the box
+ * (octahedral map over every direction) k sqrt(4 pi) R / voxel, R the distance to the farthest
+ * corner. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map
+ * tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again
+ * whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
+ * what was chosen. On the walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
 #define UMBRA_MAP_SIZE_AUTO 0u
 #define UMBRA_MAP_SIZE_AUTO_MIN 64u
 #define UMBRA_MAP_SIZE_AUTO_MAX 2048u
