@@ -77,7 +77,7 @@ static void usage(FILE *f)
             "  per scene, shading on and off, and technique: frames in which the camera orbits\n"
             "  (map cached), the light orbits (map rebuilt) and the opacity changes (map and\n"
             "  tables rebuilt); median and max ms per frame, each over the unshadowed frame\n"
-            "  --quick          5 frames, 1 warm-up, images capped at 192 (1-2 minutes idle)\n"
+            "  --quick          3 frames, 1 warm-up, images capped at 192 pixels\n"
             "  --frames N       timed frames per sequence (default 24)\n"
             "  --warmup N       untimed frames before them (default 2)\n"
             "  --size WxH       image size (default: the scene's)\n"
@@ -137,7 +137,7 @@ static int parse_options(int argc, char **argv, options *o)
     }
     if (o->quick) {
         if (!frames_given)
-            o->frames = 5;
+            o->frames = 3;
         if (!warmup_given)
             o->warmup = 1;
     }
