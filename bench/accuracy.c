@@ -124,6 +124,24 @@ static void add_reference(config_list *L, float step, int exact)
         c->headline = H_REF_COARSE;
 }
 
+/* "1024" or "auto" (UMBRA_MAP_SIZE_AUTO: the renderer chooses; the run's label and the CSV's
+ * map_size column give the size chosen, from umbra_render_stats.map_size). */
+static const char *map_name(uint32_t map, char buf[16])
+{
+    if (map == UMBRA_MAP_SIZE_AUTO)
+        return "auto";
+    snprintf(buf, 16, "%u", map);
+    return buf;
+}
+
+static const char *map_label(uint32_t map, char buf[16])
+{
+    if (map == UMBRA_MAP_SIZE_AUTO)
+        return "auto size";
+    snprintf(buf, 16, "%u²", map);
+    return buf;
+}
+
 static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float threshold)
 {
     config *c = add_config(L, UMBRA_SHADOW_THRESHOLD);
@@ -132,9 +150,11 @@ static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float thr
     c->desc.map_size = map;
     c->desc.taps = taps;
     c->desc.threshold = threshold;
-    snprintf(c->label, sizeof c->label, "%u², opacity %g%s", map, threshold,
+    char a[16], b[16];
+    snprintf(c->label, sizeof c->label, "%s, opacity %g%s", map_label(map, a), threshold,
              taps > 1 ? (taps == 7 ? ", 7 taps" : taps == 13 ? ", 13 taps" : ", 21 taps") : "");
-    snprintf(c->params, sizeof c->params, "map_size=%u;taps=%u;threshold=%g", map, taps, threshold);
+    snprintf(c->params, sizeof c->params, "map_size=%s;taps=%u;threshold=%g", map_name(map, b),
+             taps, threshold);
     if (map == L->headline_map && taps == 1 && threshold == 0.5f)
         c->headline = H_THRESHOLD;
 }
@@ -146,8 +166,10 @@ static void add_cssm(config_list *L, uint32_t map, uint32_t taps)
         return;
     c->desc.map_size = map;
     c->desc.taps = taps;
-    snprintf(c->label, sizeof c->label, "%u², %u taps", map, taps);
-    snprintf(c->params, sizeof c->params, "map_size=%u;taps=%u;seed=%u", map, taps, c->desc.seed);
+    char a[16], b[16];
+    snprintf(c->label, sizeof c->label, "%s, %u taps", map_label(map, a), taps);
+    snprintf(c->params, sizeof c->params, "map_size=%s;taps=%u;seed=%u", map_name(map, b), taps,
+             c->desc.seed);
     if (map == L->headline_map && taps == 13)
         c->headline = H_CSSM;
 }
@@ -164,10 +186,11 @@ static void add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes, ui
     char budget[32] = "";
     if (nodes)
         snprintf(budget, sizeof budget, ", %u nodes", nodes);
-    snprintf(c->label, sizeof c->label, "%u², ε %g%s%s", map, eps, budget,
+    char a[16], b[16];
+    snprintf(c->label, sizeof c->label, "%s, ε %g%s%s", map_label(map, a), eps, budget,
              prefilter == 5 ? ", 5-tap prefilter" : "");
-    snprintf(c->params, sizeof c->params, "map_size=%u;epsilon=%g;max_nodes=%u;prefilter=%u", map,
-             eps, nodes, prefilter);
+    snprintf(c->params, sizeof c->params, "map_size=%s;epsilon=%g;max_nodes=%u;prefilter=%u",
+             map_name(map, b), eps, nodes, prefilter);
     if (map == L->headline_map && eps == 0.02f && prefilter == 1)
         c->headline = nodes == 0 ? H_DEEP : nodes == 3 ? H_DEEP3 : 0;
 }
@@ -202,10 +225,12 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
 static void build_configs(int quick, int papers, uint32_t max_map, float exact_step,
                           config_list *L)
 {
-    static const uint32_t maps_full[] = {512, 1024, 2048, 4096};
-    static const uint32_t maps_quick[] = {512};
+    /* auto (UMBRA_MAP_SIZE_AUTO) beside the fixed sizes, so every scene shows what it costs and
+     * loses against them; the quick sweep has 1024^2 too, the size auto is measured against. */
+    static const uint32_t maps_full[] = {UMBRA_MAP_SIZE_AUTO, 512, 1024, 2048, 4096};
+    static const uint32_t maps_quick[] = {UMBRA_MAP_SIZE_AUTO, 512, 1024};
     const uint32_t *maps = quick ? maps_quick : maps_full;
-    size_t nmaps = quick ? 1 : (papers & SCENE_PAPERS_CSSM) ? 4 : 2;
+    size_t nmaps = quick ? 3 : (papers & SCENE_PAPERS_CSSM) ? 5 : 3;
     L->count = 0;
     L->headline_map = quick ? 512 : 1024;
     add_reference(L, exact_step, 1);
@@ -232,12 +257,12 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
     if (!quick)
         add_cssm(L, 1024, 21);
     /* Unbounded deep maps stop at 2048^2: at 4096^2 one build takes about 3 minutes here. */
-    for (size_t i = 0; i < nmaps && i < 3; ++i)
+    for (size_t i = 0; i < nmaps && i < 4; ++i)
         if (maps[i] <= max_map)
             add_deep(L, maps[i], 0.02f, 0, 1);
     add_deep(L, L->headline_map, 0.02f, 3, 1);
     if (!quick) {
-        for (size_t i = 2; i < nmaps; ++i)
+        for (size_t i = 3; i < nmaps; ++i)
             if (maps[i] <= max_map)
                 add_deep(L, maps[i], 0.02f, 3, 1);
         add_deep(L, 1024, 0.02f, 2, 1);
@@ -286,6 +311,7 @@ typedef struct result {
     int reference_cached;    /* reference_ms comes from the cache */
     size_t memory;
     uint32_t channels, slices;
+    uint32_t map_size;       /* light-space maps: the size built (what auto chose), else 0 */
     uint64_t samples;
     metrics_error err;
     uint32_t width, height;
@@ -863,6 +889,10 @@ static void run_scene(bench_run *B, int si)
         row->channels = m.stats.light_channels;
         row->slices = m.stats.slices;
         row->samples = m.stats.samples;
+        row->map_size = m.stats.map_size;
+        if (c->desc.map_size == UMBRA_MAP_SIZE_AUTO && row->map_size) /* "auto size (192²)" */
+            snprintf(row->cfg.label + strlen(row->cfg.label),
+                     sizeof row->cfg.label - strlen(row->cfg.label), " (%u²)", row->map_size);
         row->width = S.width;
         row->height = S.height;
         row->reference_ms = ref_ms;
@@ -973,6 +1003,7 @@ static const char *const csv_columns[] = {
     "render_overhead", "build_over_frame", "reference_ms", "speedup_vs_reference", "memory_bytes",
     "light_channels", "slices", "samples", "rmse", "psnr_db", "max_abs", "mean_abs", "ssim",
     "pareto_time", "pareto_memory", "reference_half_step_rmse", "reference_half_step_max_abs",
+    "map_size",
 };
 
 static int csv_column(const char *name)
@@ -1024,9 +1055,10 @@ static void write_csv(bench_run *B)
         fprintf(f, "%.6g,%.6g,%.6f,%d,%d,", r->err.max_abs, r->err.mean_abs, r->err.ssim,
                 r->pareto_time, r->pareto_memory);
         if (r->ref_unc.rmse >= 0.0)
-            fprintf(f, "%.6g,%.6g\n", r->ref_unc.rmse, r->ref_unc.max_abs);
+            fprintf(f, "%.6g,%.6g,", r->ref_unc.rmse, r->ref_unc.max_abs);
         else
-            fprintf(f, ",\n");
+            fprintf(f, ",,");
+        fprintf(f, "%u\n", r->map_size);
     }
     fclose(f);
 }

@@ -14,6 +14,8 @@ static const bench_command commands[] = {
      "convolution shadows (paper's Table 1): slice distance x sub-samples x pre-integration"},
     {"accuracy", bench_accuracy,
      "every shadow technique vs the exact reference: error, time, memory (CSV, plots)"},
+    {"interactive", bench_interactive,
+     "frames of an interactive session: camera orbit, light orbit, opacity edits, per technique"},
     {"readme", bench_readme,
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
     {"scale", bench_scale,

@@ -11,7 +11,9 @@
  * map fitted to the box's projection; a point light outside the box a perspective frustum fitted
  * to the box (if its half-angle stays under 70 degrees); a point light on, inside or close to the
  * box an octahedral map over all directions, so no light position is singular. Depth is
- * normalised to [0,1] between the box's nearest and farthest points along the light. */
+ * normalised to [0,1] between the box's nearest and farthest points along the light. map_size
+ * UMBRA_MAP_SIZE_AUTO chooses the size from the box's footprint as the light sees it (the rule is
+ * in include/umbra/renderer.h); S->map_size holds the size used, which the builds must read. */
 void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
 #endif

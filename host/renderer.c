@@ -87,7 +87,7 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
     d->struct_size = sizeof *d;
     d->technique = UMBRA_SHADOW_NONE;
     d->reference_step = 0.25f;
-    d->map_size = 1024;
+    d->map_size = UMBRA_MAP_SIZE_AUTO;
     d->map_step = 0.5f;
     d->threshold = 0.5f;
     d->taps = 13;
@@ -486,6 +486,7 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
         return UMBRA_SUCCESS;
     r->built_valid = 0;
+    r->stats.map_size = 0; /* set by umbra__lightspace_setup, for the light-space techniques */
     umbra__progress_phase(r, 0.0, build_share);
     r->shadow_params.step = light_step * umbra__voxel_world(r);
     st = umbra__upload_params(r);

@@ -53,9 +53,10 @@ static float deep_light_step(const umbra_shadow_desc *d) { return d->map_step; }
 static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
 {
     const char *fn = "umbra_renderer_set_shadow";
-    if (d->map_size < 16 || d->map_size > 8192)
+    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep map_size %u must lie in [16, 8192]", fn, d->map_size);
+                           "%s: deep map_size %u must be 0 (auto) or lie in [16, 8192]", fn,
+                           d->map_size);
     if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: deep map_step %g voxels must lie in [0.01, 64]", fn, d->map_step);
@@ -280,7 +281,7 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const uint32_t n = r->shadow.map_size, T = s->tile;
+    const uint32_t n = s->map_size, T = s->tile;
     const size_t tiles = (size_t)s->tiles_per_row * s->tiles_per_row;
     size_t have_counter = s->counter ? sizeof(cl_uint) : 0;
     if ((st = ensure_size(ctx, &s->head, &s->head_count, tiles * sizeof(cl_int), "tile heads")) ||
@@ -363,7 +364,7 @@ static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const uint32_t n = r->shadow.map_size;
+    const uint32_t n = s->map_size;
     size_t bytes = (size_t)n * n * r->shadow.max_nodes * s->node_bytes;
     if ((st = ensure_size(ctx, &s->fixed, &s->fixed_bytes, bytes, "node array")) != UMBRA_SUCCESS)
         return st;
@@ -398,14 +399,14 @@ static umbra_status deep_build(umbra_renderer r, double *ms)
     S->max_nodes = d->max_nodes;
     S->depth_bias = 0.0f;
     S->deep_tile = s->tile;
-    S->tiles_per_row = (d->map_size + s->tile - 1) / s->tile;
+    S->tiles_per_row = (S->map_size + s->tile - 1) / s->tile; /* the size chosen, if auto */
     if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS)
         return st;
     s->tiles_per_row = S->tiles_per_row;
     s->block_size = d->block_size;
     s->channels = r->channels;
     s->max_nodes = d->max_nodes;
-    s->map_size = d->map_size;
+    s->map_size = S->map_size;
     s->node_bytes = sizeof(float) * (1u + r->channels);
     s->block_bytes = (size_t)d->block_size * s->tile * s->tile * s->node_bytes;
     if (!s->dummy && (st = create_buffer(ctx, 16, "placeholder", &s->dummy)) != UMBRA_SUCCESS)

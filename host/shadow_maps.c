@@ -35,9 +35,10 @@ static float map_light_step(const umbra_shadow_desc *d) { return d->map_step; }
 static umbra_status map_validate(umbra_renderer r, const umbra_shadow_desc *d, const char *name)
 {
     const char *fn = "umbra_renderer_set_shadow";
-    if (d->map_size < 16 || d->map_size > 8192)
+    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_size %u must lie in [16, 8192]", fn, name, d->map_size);
+                           "%s: %s map_size %u must be 0 (auto) or lie in [16, 8192]", fn, name,
+                           d->map_size);
     if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: %s map_step %g voxels must lie in [0.01, 64]", fn, name,
@@ -80,9 +81,9 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
         r->tech_state = s;
     }
     const umbra_shadow_desc *d = &r->shadow;
-    const uint32_t n = d->map_size;
     UmbraShadow *S = &r->shadow_params;
-    umbra__lightspace_setup(r, n);
+    umbra__lightspace_setup(r, d->map_size);
+    const uint32_t n = S->map_size; /* the size chosen, when d->map_size is auto */
     S->threshold = d->threshold;
     S->taps = d->taps;
     S->seed = d->seed;

@@ -134,13 +134,34 @@ UMBRA_API const char *umbra_shadow_technique_name(umbra_shadow_technique techniq
 /* Parses a name; UMBRA_ERROR_INVALID_ARGUMENT for an unknown one. */
 UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
 
+/* map_size UMBRA_MAP_SIZE_AUTO (the default) lets each build of a light-space map choose its
+ * resolution from the volume's footprint as the light sees it: k texels per voxel (the smallest
+ * spacing) across the box's projection, k = 1 for the threshold map (one depth per texel: finer
+ * maps sample the same voxels again), 3 for CSSM (its taps are fixed in texels, radius 4 for 13
+ * taps, so fewer texels per voxel blur the shadow over several voxels) and 2 for the deep map
+ * (nearest-texel lookup: its error keeps falling with the size; README, "Map size"). A
+ * directional light's orthographic map gets k times the wider side of the box's projection in
+ * voxels; a point light's frustum the same measured at the distance of the box's centre (the near
+ * side gets more texels per voxel, the far side fewer); a point light inside or near the box
+ * (octahedral map over every direction) k sqrt(4 pi) R / voxel, R the distance to the farthest
+ * corner. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map
+ * tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again
+ * whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
+ * what was chosen. On the walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
+#define UMBRA_MAP_SIZE_AUTO 0u
+#define UMBRA_MAP_SIZE_AUTO_MIN 64u
+#define UMBRA_MAP_SIZE_AUTO_MAX 2048u
+#define UMBRA_MAP_SIZE_AUTO_ROUND 32u
+
 typedef struct umbra_shadow_desc {
     size_t struct_size;          /* sizeof(umbra_shadow_desc); set by umbra_shadow_desc_init */
     umbra_shadow_technique technique; /* default UMBRA_SHADOW_NONE */
     /* reference */
     float reference_step;        /* shadow-ray step in voxels (default 0.25) */
     /* light-space maps */
-    uint32_t map_size;           /* map resolution, map_size^2 texels (default 1024) */
+    uint32_t map_size;           /* map resolution, map_size^2 texels: UMBRA_MAP_SIZE_AUTO
+                                    (0, the default: chosen from the scene, rule below) or
+                                    16..8192; stats.map_size reports the size built */
     float map_step;              /* light-ray step in voxels (default 0.5) */
     float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
                                     a texel's depth is stored (default 0.5); one grey depth per
@@ -268,6 +289,9 @@ typedef struct umbra_render_stats {
     uint64_t samples;            /* view samples taken in the last render (skipped ones excluded) */
     umbra_timing shadow_build_timing; /* what shadow_build_ms measures */
     umbra_timing render_timing;  /* what render_ms measures */
+    uint32_t map_size;           /* light-space techniques: texels per side of the map in use
+                                    (the size UMBRA_MAP_SIZE_AUTO chose, or the one given);
+                                    0 for the others. Fields are only ever appended here */
 } umbra_render_stats;
 
 /* Copies the last render's figures into *out. UMBRA_ERROR_INVALID_ARGUMENT for NULL r or out. */

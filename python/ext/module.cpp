@@ -69,6 +69,8 @@ NB_MODULE(_umbra, m)
         nullptr, nullptr);
     m.attr("Error") = nb::steal(error_type);
 
+    m.attr("MAP_SIZE_AUTO") = UMBRA_MAP_SIZE_AUTO;
+
     m.def(
         "version", []() { return std::string(umbra_version()); },
         "The C library's version, 'MAJOR.MINOR.PATCH'.");

@@ -278,7 +278,10 @@ void bind_objects(nb::module_ &m)
         .def_ro("shadow_memory_bytes", &umbra_render_stats::shadow_memory_bytes)
         .def_ro("light_channels", &umbra_render_stats::light_channels)
         .def_ro("slices", &umbra_render_stats::slices)
-        .def_ro("samples", &umbra_render_stats::samples);
+        .def_ro("samples", &umbra_render_stats::samples)
+        .def_ro("map_size", &umbra_render_stats::map_size,
+                "light-space techniques: texels per side of the map in use (the size auto "
+                "chose), else 0");
 
     /* ---- Renderer ---- */
     static const std::string set_shadow_doc =

@@ -175,7 +175,9 @@ void bind_options(nb::module_ &m)
                "none, reference, threshold, deep, cssm or convolution");
     field(so, "reference_step", &umbra_shadow_desc::reference_step,
           "reference: shadow-ray step in voxels");
-    field(so, "map_size", &umbra_shadow_desc::map_size, "light-space maps: map_size^2 texels");
+    field(so, "map_size", &umbra_shadow_desc::map_size,
+          "light-space maps: map_size^2 texels, 0 (MAP_SIZE_AUTO, the default: about one texel "
+          "per voxel seen from the light; stats.map_size says what was chosen) or 16..8192");
     field(so, "map_step", &umbra_shadow_desc::map_step,
           "light-space maps: light-ray step in voxels");
     field(so, "threshold", &umbra_shadow_desc::threshold,

@@ -97,8 +97,8 @@ def test_query_shadow_bad_points(ctx):
 def test_bad_options_name_the_value(ctx):
     s = umbra.Scene(ctx, "slab", 16)
     with s.renderer() as r:
-        with raises_invalid(r"map_size 0 must lie in \[16, 8192\]"):
-            r.set_shadow(technique="deep", map_size=0)
+        with raises_invalid(r"map_size 8 must be 0 \(auto\) or lie in \[16, 8192\]"):
+            r.set_shadow(technique="deep", map_size=8)
         with pytest.raises(TypeError, match="unknown parameter 'mapsize'.*map_size"):
             r.render(8, 8, technique="deep", mapsize=64)
         with pytest.raises(TypeError, match=r"taps=-1 is not a valid int"):

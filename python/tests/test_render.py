@@ -94,8 +94,21 @@ def test_technique_parameters_reach_the_renderer(ctx, spheres):
         r.set_shadow(technique=umbra.Technique.CSSM, map_size=256)
         r.render(32, 24)
         assert r.stats.shadow_memory_bytes == 4 * small
+        assert r.stats.map_size == 256
         # parameters not given take the C defaults again, not the previous values
         assert r.shadow.taps == umbra.ShadowOptions().taps
+
+
+def test_map_size_auto_is_the_default_and_reported(ctx, spheres):
+    assert umbra.ShadowOptions().map_size == umbra.MAP_SIZE_AUTO == 0
+    with spheres.renderer() as r:
+        r.render(32, 24, technique="threshold")
+        auto = r.stats.map_size
+        # the rule of include/umbra/renderer.h: a multiple of 32 within [64, 2048]
+        assert 64 <= auto <= 2048 and auto % 32 == 0
+        assert r.stats.shadow_memory_bytes == 4 * auto * auto
+        r.render(32, 24, technique="none")
+        assert r.stats.map_size == 0
 
 
 def test_render_into_callers_array(ctx, spheres):
