@@ -40,24 +40,57 @@ typedef struct ShadowRay {
 
 inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
-/* Gauss-Legendre over [a, b] (table units, within one table interval) of the extinction per
- * light channel: the integral, and the range of the outer nodes' values into lo, hi. */
+/* The moments over tau in [0, 1] of -ln(1 - r tau), the extinction's excess over its value at a
+ * piece's more transparent end where the opacity rises linearly to the other (r = the rise over
+ * that end's 1 - a, 1 - r = the other's 1 - a over this one's, om_r; lr = -ln(1 - r)):
+ * .x = int -ln(1 - r tau) = 1 - (1 - r) lr / r, .y = int tau (-ln(1 - r tau)) =
+ * (lr (1 - 1 / r^2) + 1 / r + 1 / 2) / 2. Both cancel for small r, where their series
+ * sum_k r^k / (k (k + 1)) and sum_k r^k / (k (k + 2)) take over (r < 1/2, 18 terms: truncation
+ * below 4e-8 of the result). */
+inline float2 log_moments(float r, float om_r, float lr)
+{
+    if (r < 0.5f) {
+        float p = 0.0f, q = 0.0f;
+        for (int k = 18; k >= 1; --k) {
+            p = r * (p + 1.0f / (float)(k * (k + 1)));
+            q = r * (q + 1.0f / (float)(k * (k + 2)));
+        }
+        return (float2)(p, q);
+    }
+    const float ir = 1.0f / r;
+    return (float2)(1.0f - om_r * lr * ir, 0.5f * (lr * (1.0f - ir * ir) + ir + 0.5f));
+}
+
+/* The optical depth per light channel of [a, b] (table units, within one table interval), in
+ * table units, exact: across an interval the opacity a and the colour t run linearly, so the
+ * extinction -ln(1 - a) (1 - t_c) integrates in closed form, from the more transparent end e
+ * (a rise r = (a_o - a_e) / (1 - a_e) to the other end o): (b - a) (f_e m0 + (f_o - f_e) m1),
+ * f = 1 - t_c, m0 = s_e + phi(r), m1 = s_e / 2 + psi(r) (log_moments), s = -ln(1 - a). The ends'
+ * opacities are clamped to UMBRA_ALPHA_MAX before, not after, the interpolation between them,
+ * which differs from tf_extinction only where the table reaches opacity 1, over 2^-24 of an
+ * interval. The range of the extinction over the piece (its two ends: it is monotonic in a)
+ * widens lo, hi. Two logs, where three-point Gauss took three and three table lookups. */
 inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, uint flags,
                            float *lo, float *hi)
 {
-    const float last = (float)(n - 1);
     const int i = min((int)a, (int)n - 2);
-    if (tf[i].w == 0.0f && tf[i + 1].w == 0.0f) { /* transparent: the common case, no logs */
+    const float4 c0 = tf[i], c1 = tf[i + 1];
+    if (c0.w == 0.0f && c1.w == 0.0f) { /* transparent: the common case, no logs */
         *lo = 0.0f;
         return (light_t)(0.0f);
     }
-    const float m = 0.5f * (a + b), r = 0.38729833f * (b - a); /* nodes m, m -+ r */
-    const light_t s0 = light_depth(tf_lookup(tf, n, (m - r) / last), 1.0f, flags);
-    const light_t s1 = light_depth(tf_lookup(tf, n, m / last), 1.0f, flags);
-    const light_t s2 = light_depth(tf_lookup(tf, n, (m + r) / last), 1.0f, flags);
-    *lo = fmin(*lo, fmin(light_min(s0), light_min(s2)));
-    *hi = fmax(*hi, fmax(light_max(s0), light_max(s2)));
-    return ((b - a) / 18.0f) * (5.0f * s0 + 8.0f * s1 + 5.0f * s2);
+    float4 ca = mix(c0, c1, a - (float)i), cb = mix(c0, c1, b - (float)i);
+    ca.w = fmin(ca.w, UMBRA_ALPHA_MAX);
+    cb.w = fmin(cb.w, UMBRA_ALPHA_MAX);
+    const float4 ce = cb.w >= ca.w ? ca : cb, co = cb.w >= ca.w ? cb : ca;
+    const float se = -log1p(-ce.w), so = -log1p(-co.w);
+    const float qe = 1.0f - ce.w;
+    const float2 m = log_moments((co.w - ce.w) / qe, (1.0f - co.w) / qe, so - se);
+    const light_t fe = light_absorbed(ce, flags), fo = light_absorbed(co, flags);
+    const light_t de = se * fe, dob = so * fo;
+    *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
+    *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
+    return (b - a) * (fe * (se + m.x) + (fo - fe) * (0.5f * se + m.y));
 }
 
 /* The sum of the interval depths of the table's entries [0, k) (host/renderer.c, after the n

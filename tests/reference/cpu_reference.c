@@ -299,6 +299,43 @@ static float walk_to_visible(const prep *P, walk *w, float t, float t_end)
     }
 }
 
+/* The integral over a table interval (table units) between the entries e0 and e1 (RGBA) of the
+ * extinction -ln(1 - a) times 1 - t_c (c = r, g, b) and times 1 (grey), a and t linear between
+ * them, a at most 1 - 2^-24 (clamped at the entries): in double, from the substitution
+ * q = 1 - a. Over tau in [0, 1] from the more transparent end e, with x = 1 - (1 - a_o) /
+ * (1 - a_e) the relative fall of q: int -ln q = s_e + A(x), int tau (-ln q) = s_e / 2 + B(x),
+ * A(x) = 1 + (1 - x) ln(1 - x) / x, B(x) = (-ln(1 - x) (1 - 1 / x^2) + 1 / x + 1 / 2) / 2, summed
+ * as their Taylor series for x < 1/2 where those cancel. *s_e, *s_o: the ends' extinctions
+ * -ln(1 - a) (if not NULL). */
+static void linear_extinction(const float *e0, const float *e1, double out[4], double *s_e,
+                              double *s_o)
+{
+    const double amax = 0.99999994039535522;
+    double a0 = e0[3] < amax ? e0[3] : amax, a1 = e1[3] < amax ? e1[3] : amax;
+    const float *ce = a1 >= a0 ? e0 : e1, *co = a1 >= a0 ? e1 : e0;
+    double ae = a1 >= a0 ? a0 : a1, ao = a1 >= a0 ? a1 : a0;
+    double se = -log1p(-ae), so = -log1p(-ao), x = (ao - ae) / (1.0 - ae), A = 0.0, B = 0.0;
+    if (x < 0.5) {
+        double xk = 1.0;
+        for (int k = 1; k <= 60; ++k) {
+            xk *= x;
+            A += xk / ((double)k * (k + 1));
+            B += xk / ((double)k * (k + 2));
+        }
+    } else {
+        double L = so - se;
+        A = 1.0 - (1.0 - ao) / (1.0 - ae) * L / x;
+        B = 0.5 * (L * (1.0 - 1.0 / (x * x)) + 1.0 / x + 0.5);
+    }
+    for (int k = 0; k < 3; ++k)
+        out[k] = (1.0 - ce[k]) * (se + A) + (ce[k] - co[k]) * (0.5 * se + B);
+    out[3] = se + A;
+    if (s_e)
+        *s_e = se;
+    if (s_o)
+        *s_o = so;
+}
+
 static void prep_init(prep *P, const cpu_scene *s)
 {
     memset(P, 0, sizeof *P);
@@ -324,23 +361,8 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->light_bricks = bricks(P, ltf, P->light_n);
     P->light_int = malloc((size_t)4 * (P->light_n - 1) * sizeof *P->light_int);
     if (P->light_int)
-        for (int i = 0; i + 1 < P->light_n; ++i) {
-            /* composite three-point Gauss over 16 pieces, in double */
-            static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
-            static const double gw[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-            double *o = P->light_int + 4 * i;
-            o[0] = o[1] = o[2] = o[3] = 0.0;
-            for (int q = 0; q < 48; ++q) {
-                double w = (q / 3 + 0.5 + 0.5 * gx[q % 3]) / 16.0, c[4];
-                for (int k = 0; k < 4; ++k)
-                    c[k] = ltf[4 * i + k] + w * (ltf[4 * i + 4 + k] - ltf[4 * i + k]);
-                double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
-                double sg = -log1p(-a) * gw[q % 3] / 16.0;
-                for (int k = 0; k < 3; ++k)
-                    o[k] += sg * (1.0 - c[k]);
-                o[3] += sg;
-            }
-        }
+        for (int i = 0; i + 1 < P->light_n; ++i)
+            linear_extinction(ltf + 4 * i, ltf + 4 * i + 4, P->light_int + 4 * i, NULL, NULL);
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
     P->point = s->light.type == UMBRA_LIGHT_POINT;
     P->light_vec = P->point ? from(s->light.position) : norm(from(s->light.direction));
@@ -415,37 +437,44 @@ static void depth_rate(const prep *P, const float c[4], float out[3])
         out[ch] = sigma * (P->colored ? 1.0f - c[ch] : 1.0f);
 }
 
-/* Three-point Gauss over [a, b] (table units, within one interval) of the extinction rate per
- * channel, added to out; lo, hi take the outer nodes' range. A transparent interval adds 0 and
- * sets lo to 0, as the kernel does. */
+/* The integral over [a, b] (table units, within one interval) of the extinction rate per
+ * channel, added to out: linear_extinction between the interpolated ends, times b - a; lo, hi
+ * take the range of the ends' rates (the rate is monotonic in a). A transparent interval adds 0
+ * and sets lo to 0, as the kernel does. */
 static void piece(const prep *P, float a, float b, double out[3], float *lo, float *hi)
 {
     const int n = P->light_n;
-    const float last = (float)(n - 1);
     int i = (int)a < n - 2 ? (int)a : n - 2;
-    if (P->light_tf[4 * i + 3] == 0.0f && P->light_tf[4 * i + 7] == 0.0f) {
+    const float *t = P->light_tf + 4 * i;
+    if (t[3] == 0.0f && t[7] == 0.0f) {
         *lo = 0.0f;
         return;
     }
-    float m = 0.5f * (a + b), hw = 0.38729833f * (b - a), c[4], r[3];
-    for (int q = -1; q <= 1; ++q) {
-        lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
-        depth_rate(P, c, r);
-        for (int ch = 0; ch < 3; ++ch) {
-            out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
-            if (q) {
-                *lo = fminf(*lo, r[ch]);
-                *hi = fmaxf(*hi, r[ch]);
-            }
-        }
+    float ca[4], cb[4];
+    for (int k = 0; k < 4; ++k) {
+        ca[k] = lerp(t[k], t[4 + k], a - (float)i);
+        cb[k] = lerp(t[k], t[4 + k], b - (float)i);
+    }
+    double m[4], sa, sb;
+    linear_extinction(ca, cb, m, &sa, &sb);
+    if (cb[3] < ca[3]) { /* s_e belongs to b */
+        double s = sa;
+        sa = sb;
+        sb = s;
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        out[ch] += (double)(b - a) * (P->colored ? m[ch] : m[3]);
+        float ra = (float)sa * (P->colored ? 1.0f - ca[ch] : 1.0f);
+        float rb = (float)sb * (P->colored ? 1.0f - cb[ch] : 1.0f);
+        *lo = fminf(*lo, fminf(ra, rb));
+        *hi = fmaxf(*hi, fmaxf(ra, rb));
     }
 }
 
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
- * the mean extinction over [v0, v1]: the partial table intervals at the ends by three-point
- * Gauss, the whole ones between from their integrals (light_int), as kernels/shadow_reference.cl;
- * *spread: the range of the extinction over the Gauss nodes and the whole intervals' mean,
- * times len. */
+ * the mean extinction over [v0, v1]: the partial table intervals at the ends and the whole ones
+ * between in closed form (piece, light_int), as kernels/shadow_reference.cl; *spread: the range
+ * of the extinction over the pieces' ends and the whole intervals' mean, times len. */
 static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
     const int n = P->light_n;
