@@ -172,8 +172,8 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
     return best;
 }
 
-/* The optical depth of the segment [ta, tb] of the ray p + t d (len voxels long; xo, xd the ray
- * in voxel coordinates) whose ends have the values va, vb: segment_depth, refined where the value's
+/* The optical depth of the segment [ta, tb] of the ray p + t d (per_t voxels per unit of t; xo, xd
+ * the ray in voxel coordinates) whose ends have the values va, vb: segment_depth, refined where the value's
  * departure from a straight line within the segment would shift the extinction, by splitting it
  * at a new sample (depth-first, with an explicit stack, at most SEG_REFINE_LEVELS deep):
  *  - where the ray crosses a plane of voxel centres (the trilinear interpolant's kinks, an error
@@ -187,13 +187,12 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
 #define SEG_KINK_DEPTH 1e-3f
 inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
                                uint flags, float3 p, float3 d, float3 xo, float3 xd, float ta,
-                               float tb, float va, float vb, float len)
+                               float tb, float va, float vb, float per_t)
 {
     float st_t[SEG_REFINE_LEVELS + 1], st_v[SEG_REFINE_LEVELS + 1];
     int st_l[SEG_REFINE_LEVELS + 1];
     int top = 0;
     light_t D = (light_t)(0.0f);
-    const float per_t = len / (tb - ta); /* voxels per unit of t */
     /* The current piece is [ta, st_t[top]] with values va, st_v[top], at level st_l[top]; the
      * stack holds the ends of the pieces still to do. */
     st_t[0] = tb;
@@ -241,7 +240,10 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     if (!(t_end > t_start))
         return (float3)(1.0f);
     const float h = S->step;
-    const float h_vox = light_step_voxels(F, S);
+    /* Voxels per unit of t, the same for every segment: a segment's length in voxels is its
+     * length in t times this (the final partial one's too, whose length in t can round to 0;
+     * its length in voxels taken as h_vox (last / h) over that made 0 / 0, a NaN pixel). */
+    const float per_t = light_step_voxels(F, S) / h;
     const uint n_tf = F->light_tf_size;
     const uint flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
@@ -273,7 +275,7 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
         const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
         const float ta = t_start + (float)k * h;
         const light_t y = segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, ta, ta + h,
-                                          v_k, v_next, h_vox) - comp;
+                                          v_k, v_next, per_t) - comp;
         const light_t s = D + y;
         comp = (s - D) - y;
         D = s;
@@ -284,13 +286,13 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     }
     /* The final partial segment, always integrated: skipping above may stop at a sample in an
      * invisible cell before a visible one at the box face. */
-    if (last > 0.0f) {
-        const float t_k = t_start + (float)n_full * h;
+    const float t_k = t_start + (float)n_full * h;
+    if (last > 0.0f && t_end > t_k) {
         if (k_have != n_full)
             v_k = sample_volume(vol, g, p + t_k * d);
         const float v_end = sample_volume(vol, g, p + t_end * d);
         D += segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, t_k, t_end, v_k, v_end,
-                             h_vox * (last / h)) - comp;
+                             per_t) - comp;
     }
     return light_rgb(exp(-D));
 }

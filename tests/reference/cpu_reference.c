@@ -593,14 +593,15 @@ static v3 shadow(const prep *P, v3 p)
     for (int k = 0; k <= n_full; ++k) {
         float ta_k = t_start + (float)k * h;
         float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
-        float seg = k < n_full ? h_vox : h_vox * (last / h);
-        if (k == n_full && !(last > 0.0f))
+        if (k == n_full && !(last > 0.0f && tb_k > ta_k))
             break;
         v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
         if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
             continue;
-        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb),
-                        seg / (tb_k - ta_k), 0, D);
+        /* voxels per unit of t, h_vox / h for every segment (the last one's t-length can
+         * round to 0, kernels/shadow_reference.cl) */
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb), h_vox / h, 0,
+                        D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
