@@ -50,12 +50,23 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 inline float2 log_moments(float r, float om_r, float lr)
 {
     if (r < 0.5f) {
-        float p = 0.0f, q = 0.0f;
-        for (int k = 18; k >= 1; --k) {
-            p = r * (p + 1.0f / (float)(k * (k + 1)));
-            q = r * (q + 1.0f / (float)(k * (k + 2)));
+        /* Horner over the coefficients 1 / (k (k + 1)) and 1 / (k (k + 2)), k = 18 .. 1 */
+        const float c_phi[18] = {
+            2.92397661e-03f, 3.26797386e-03f, 3.67647059e-03f, 4.16666667e-03f, 4.76190476e-03f,
+            5.49450549e-03f, 6.41025641e-03f, 7.57575758e-03f, 9.09090909e-03f, 1.11111111e-02f,
+            1.38888889e-02f, 1.78571429e-02f, 2.38095238e-02f, 3.33333333e-02f, 5.00000000e-02f,
+            8.33333333e-02f, 1.66666667e-01f, 5.00000000e-01f};
+        const float c_psi[18] = {
+            2.77777778e-03f, 3.09597523e-03f, 3.47222222e-03f, 3.92156863e-03f, 4.46428571e-03f,
+            5.12820513e-03f, 5.95238095e-03f, 6.99300699e-03f, 8.33333333e-03f, 1.01010101e-02f,
+            1.25000000e-02f, 1.58730159e-02f, 2.08333333e-02f, 2.85714286e-02f, 4.16666667e-02f,
+            6.66666667e-02f, 1.25000000e-01f, 3.33333333e-01f};
+        float phi = 0.0f, psi = 0.0f;
+        for (int k = 0; k < 18; ++k) {
+            phi = fma(phi, r, c_phi[k]);
+            psi = fma(psi, r, c_psi[k]);
         }
-        return (float2)(p, q);
+        return (float2)(phi * r, psi * r);
     }
     const float ir = 1.0f / r;
     return (float2)(1.0f - om_r * lr * ir, 0.5f * (lr * (1.0f - ir * ir) + ir + 0.5f));
@@ -83,10 +94,17 @@ inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, 
     ca.w = fmin(ca.w, UMBRA_ALPHA_MAX);
     cb.w = fmin(cb.w, UMBRA_ALPHA_MAX);
     const float4 ce = cb.w >= ca.w ? ca : cb, co = cb.w >= ca.w ? cb : ca;
-    const float se = -log1p(-ce.w), so = -log1p(-co.w);
+    const float se = -log1p(-ce.w);
+    const light_t fe = light_absorbed(ce, flags), fo = light_absorbed(co, flags);
+    if (co.w == ce.w) { /* a plateau of the opacity: one log */
+        const light_t de = se * fe, dob = se * fo;
+        *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
+        *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
+        return (0.5f * (b - a)) * (de + dob);
+    }
+    const float so = -log1p(-co.w);
     const float qe = 1.0f - ce.w;
     const float2 m = log_moments((co.w - ce.w) / qe, (1.0f - co.w) / qe, so - se);
-    const light_t fe = light_absorbed(ce, flags), fo = light_absorbed(co, flags);
     const light_t de = se * fe, dob = so * fo;
     *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
     *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
@@ -172,56 +190,85 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
     return best;
 }
 
-/* The optical depth of the segment [ta, tb] of the ray p + t d (per_t voxels per unit of t; xo, xd
- * the ray in voxel coordinates) whose ends have the values va, vb: segment_depth, refined where the value's
- * departure from a straight line within the segment would shift the extinction, by splitting it
- * at a new sample (depth-first, with an explicit stack, at most SEG_REFINE_LEVELS deep):
+/* The optical depth of the segment [ta, tb] of the ray p + t d (len voxels long, per_t voxels per
+ * unit of t; xo, xd the ray in voxel coordinates) whose ends have the values va, vb:
+ * segment_depth, refined where the value's departure from a straight line within the segment
+ * would shift the extinction. A piece
+ * is a candidate for a split at a new sample
  *  - where the ray crosses a plane of voxel centres (the trilinear interpolant's kinks, an error
- *    of first order in the segment's length) and the extinction varies along the segment by more
+ *    of first order in the piece's length) and the extinction varies along the piece by more
  *    than SEG_KINK_DEPTH of optical depth, at that crossing: past the kinks the pieces are smooth,
  *    and a value linear in space along an axis is integrated exactly;
  *  - else, where it varies by more than SEG_REFINE_DEPTH (the interpolant's curvature, an error
- *    of second order), at the middle. */
+ *    of second order), at the middle;
+ * and the split is taken: the two halves' depths replace the piece's. Where those differ from it
+ * by more than SEG_REFINE_TOL in some channel, each half is a candidate in turn (depth-first,
+ * with an explicit stack, at most SEG_REFINE_LEVELS deep); where they agree, the halves are
+ * kept and the refinement stops there: most candidates are smooth pieces over a steep part of
+ * the transfer function, which the first split already shows to be resolved. */
 #define SEG_REFINE_LEVELS 3
 #define SEG_REFINE_DEPTH 4e-3f
 #define SEG_KINK_DEPTH 1e-3f
+#ifndef SEG_REFINE_TOL
+#define SEG_REFINE_TOL 1e-5f
+#endif
 inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
                                uint flags, float3 p, float3 d, float3 xo, float3 xd, float ta,
-                               float tb, float va, float vb, float per_t)
+                               float tb, float va, float vb, float len, float per_t)
 {
-    float st_t[SEG_REFINE_LEVELS + 1], st_v[SEG_REFINE_LEVELS + 1];
-    int st_l[SEG_REFINE_LEVELS + 1];
-    int top = 0;
+    /* The pieces still to do after the current one: their ends, values at the ends, lengths,
+     * depths, spreads and levels (each starts where the one above it ends). A split divides a
+     * piece's length in voxels between its halves, so that they add up to the segment's. */
+    float st_t[SEG_REFINE_LEVELS], st_v[SEG_REFINE_LEVELS], st_s[SEG_REFINE_LEVELS];
+    float st_len[SEG_REFINE_LEVELS];
+    light_t st_d[SEG_REFINE_LEVELS];
+    int st_l[SEG_REFINE_LEVELS];
+    int top = -1, level = 0;
+    float spread;
+    light_t dd = segment_depth(tf, n, va, vb, len, flags, &spread);
     light_t D = (light_t)(0.0f);
-    /* The current piece is [ta, st_t[top]] with values va, st_v[top], at level st_l[top]; the
-     * stack holds the ends of the pieces still to do. */
-    st_t[0] = tb;
-    st_v[0] = vb;
-    st_l[0] = 0;
     for (;;) {
-        const float tb_ = st_t[top], vb_ = st_v[top];
-        const int level = st_l[top];
-        float spread;
-        const light_t dd = segment_depth(tf, n, va, vb_, (tb_ - ta) * per_t, flags, &spread);
+        /* The current piece: [ta, tb], len voxels, values va, vb, depth dd and its spread. */
         float tm = -1.0f;
         if (level < SEG_REFINE_LEVELS && spread > SEG_KINK_DEPTH) {
-            tm = seg_kink(g, xo, xd, ta, tb_);
+            tm = seg_kink(g, xo, xd, ta, tb);
             if (tm < 0.0f && spread > SEG_REFINE_DEPTH)
-                tm = 0.5f * (ta + tb_);
+                tm = 0.5f * (ta + tb);
         }
         if (tm >= 0.0f) {
-            st_l[top] = level + 1;
-            ++top;
-            st_t[top] = tm;
-            st_v[top] = sample_volume(vol, g, p + tm * d);
-            st_l[top] = level + 1;
-            continue;
+            const float vm = sample_volume(vol, g, p + tm * d);
+            const float len_l = clamp((tm - ta) * per_t, 0.0f, len), len_r = len - len_l;
+            float s_l, s_r;
+            const light_t d_l = segment_depth(tf, n, va, vm, len_l, flags, &s_l);
+            const light_t d_r = segment_depth(tf, n, vm, vb, len_r, flags, &s_r);
+            if (light_max(fabs(d_l + d_r - dd)) > SEG_REFINE_TOL) {
+                ++top;
+                st_t[top] = tb;
+                st_v[top] = vb;
+                st_len[top] = len_r;
+                st_d[top] = d_r;
+                st_s[top] = s_r;
+                st_l[top] = ++level;
+                tb = tm;
+                vb = vm;
+                len = len_l;
+                dd = d_l;
+                spread = s_l;
+                continue;
+            }
+            dd = d_l + d_r;
         }
         D += dd;
-        ta = tb_;
-        va = vb_;
-        if (top == 0)
+        if (top < 0)
             break;
+        ta = tb;
+        va = vb;
+        tb = st_t[top];
+        vb = st_v[top];
+        len = st_len[top];
+        dd = st_d[top];
+        spread = st_s[top];
+        level = st_l[top];
         --top;
     }
     return D;
@@ -240,10 +287,11 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     if (!(t_end > t_start))
         return (float3)(1.0f);
     const float h = S->step;
-    /* Voxels per unit of t, the same for every segment: a segment's length in voxels is its
-     * length in t times this (the final partial one's too, whose length in t can round to 0;
-     * its length in voxels taken as h_vox (last / h) over that made 0 / 0, a NaN pixel). */
-    const float per_t = light_step_voxels(F, S) / h;
+    /* A whole step is h_vox voxels long, the final partial one h_vox last / h; the pieces of
+     * a refined step divide its length at per_t voxels per unit of t (the final step's length in
+     * t, t_end - t_k, can round to 0 where last does not: dividing by it gave 0 / 0, a NaN
+     * pixel). */
+    const float h_vox = light_step_voxels(F, S), per_t = h_vox / h;
     const uint n_tf = F->light_tf_size;
     const uint flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
@@ -275,7 +323,7 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
         const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
         const float ta = t_start + (float)k * h;
         const light_t y = segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, ta, ta + h,
-                                          v_k, v_next, per_t) - comp;
+                                          v_k, v_next, h_vox, per_t) - comp;
         const light_t s = D + y;
         comp = (s - D) - y;
         D = s;
@@ -286,13 +334,13 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     }
     /* The final partial segment, always integrated: skipping above may stop at a sample in an
      * invisible cell before a visible one at the box face. */
-    const float t_k = t_start + (float)n_full * h;
-    if (last > 0.0f && t_end > t_k) {
+    if (last > 0.0f) {
+        const float t_k = t_start + (float)n_full * h;
         if (k_have != n_full)
             v_k = sample_volume(vol, g, p + t_k * d);
         const float v_end = sample_volume(vol, g, p + t_end * d);
         D += segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, t_k, t_end, v_k, v_end,
-                             per_t) - comp;
+                             last * per_t, per_t) - comp;
     }
     return light_rgb(exp(-D));
 }

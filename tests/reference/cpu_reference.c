@@ -539,15 +539,16 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
     return best;
 }
 
-/* segment, split at a new sample (recursively, at most 3 deep) as kernels/shadow_reference.cl:
- * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-3 of
- * optical depth, else at its middle if by more than 4e-3. */
+/* segment (len voxels, depth f, spread) refined as kernels/shadow_reference.cl does: a
+ * candidate for a split at a new sample at a plane of voxel centres it crosses if the extinction
+ * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
+ * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
+ * candidates in turn (recursively, at most 3 deep) only where they differ from it by more than
+ * 1e-5 in some channel. */
 static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
-                            float ta, float tb, float va, float vb, float per_t, int level,
-                            double D[3])
+                            float ta, float tb, float va, float vb, float len, float per_t,
+                            int level, const float f[3], float spread, double D[3])
 {
-    float f[3], spread;
-    segment(P, va, vb, (tb - ta) * per_t, f, &spread);
     float tm = -1.0f;
     if (level < 3 && spread > 1e-3f) {
         tm = kink(P, xo, xd, ta, tb);
@@ -556,8 +557,19 @@ static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const 
     }
     if (tm >= 0.0f) {
         float vm = sample(P, add(p, mul(d, tm)));
-        segment_refined(P, p, d, xo, xd, ta, tm, va, vm, per_t, level + 1, D);
-        segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, per_t, level + 1, D);
+        float len_l = clampf((tm - ta) * per_t, 0.0f, len), len_r = len - len_l;
+        float fl[3], fr[3], sl, sr, diff = 0.0f;
+        segment(P, va, vm, len_l, fl, &sl);
+        segment(P, vm, vb, len_r, fr, &sr);
+        for (int ch = 0; ch < 3; ++ch)
+            diff = fmaxf(diff, fabsf(fl[ch] + fr[ch] - f[ch]));
+        if (diff > 1e-5f) {
+            segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl, D);
+            segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr, D);
+            return;
+        }
+        for (int ch = 0; ch < 3; ++ch)
+            D[ch] += (double)fl[ch] + fr[ch];
         return;
     }
     for (int ch = 0; ch < 3; ++ch)
@@ -593,15 +605,18 @@ static v3 shadow(const prep *P, v3 p)
     for (int k = 0; k <= n_full; ++k) {
         float ta_k = t_start + (float)k * h;
         float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
-        if (k == n_full && !(last > 0.0f && tb_k > ta_k))
+        if (k == n_full && !(last > 0.0f))
             break;
         v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
         if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
             continue;
-        /* voxels per unit of t, h_vox / h for every segment (the last one's t-length can
-         * round to 0, kernels/shadow_reference.cl) */
-        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb), h_vox / h, 0,
-                        D);
+        /* h_vox voxels a whole step, h_vox last / h the final one; its pieces divide that at
+         * h_vox / h voxels per unit of t (its t-length can round to 0, kernels/
+         * shadow_reference.cl) */
+        float va = sample(P, qa), vb = sample(P, qb), len = k < n_full ? h_vox : last * (h_vox / h);
+        float f[3], spread;
+        segment(P, va, vb, len, f, &spread);
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, va, vb, len, h_vox / h, 0, f, spread, D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
