@@ -61,14 +61,15 @@ static void interval_depths(const float *e, double out[4])
  * followed by 2 count float4: for each entry k, the sum over the intervals before it of
  * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
  * from which the exact reference takes the depth of whole table intervals with two loads and no
- * cancellation (kernels/shadow_reference.cl). */
+ * cancellation (kernels/shadow_reference.cl), then count float4 holding each entry's extinction
+ * -ln(1 - a) (a clamped to 1 - 2^-24) in x, so that it takes no log at a table entry. */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     const int light = step_voxels == 0.0f;
-    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 3 : 1);
+    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 4 : 1);
     float *t = malloc(bytes);
     if (!t)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
@@ -93,6 +94,13 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
                 for (int c = 0; c < 4; ++c)
                     sum[c] += d[c];
             }
+        }
+        float *e = t + 12 * (size_t)tf->count;
+        for (uint32_t k = 0; k < tf->count; ++k) {
+            double a = tf->rgba[4 * k + 3] < 0.99999994039535522 ? tf->rgba[4 * k + 3]
+                                                                 : 0.99999994039535522;
+            e[4 * k] = (float)-log1p(-a);
+            e[4 * k + 1] = e[4 * k + 2] = e[4 * k + 3] = 0.0f;
         }
     }
     umbra__release_mem(buf);

@@ -80,7 +80,8 @@ inline float2 log_moments(float r, float om_r, float lr)
  * opacities are clamped to UMBRA_ALPHA_MAX before, not after, the interpolation between them,
  * which differs from tf_extinction only where the table reaches opacity 1, over 2^-24 of an
  * interval. The range of the extinction over the piece (its two ends: it is monotonic in a)
- * widens lo, hi. Two logs, where three-point Gauss took three and three table lookups. */
+ * widens lo, hi. At most two logs (none on a plateau of the opacity, one where an end lies on a
+ * table entry), where three-point Gauss took three and three table lookups. */
 inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, uint flags,
                            float *lo, float *hi)
 {
@@ -90,24 +91,26 @@ inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, 
         *lo = 0.0f;
         return (light_t)(0.0f);
     }
-    float4 ca = mix(c0, c1, a - (float)i), cb = mix(c0, c1, b - (float)i);
+    /* The ends, and their extinctions: an end on a table entry (or a plateau of the opacity)
+     * takes the entry's from the host (after the prefix sums), the others a log. */
+    const float fa = a - (float)i, fb = b - (float)i;
+    float4 ca = fa == 0.0f ? c0 : mix(c0, c1, fa), cb = fb == 1.0f ? c1 : mix(c0, c1, fb);
     ca.w = fmin(ca.w, UMBRA_ALPHA_MAX);
     cb.w = fmin(cb.w, UMBRA_ALPHA_MAX);
-    const float4 ce = cb.w >= ca.w ? ca : cb, co = cb.w >= ca.w ? cb : ca;
-    const float se = -log1p(-ce.w);
+    const int plateau = c0.w == c1.w;
+    const float sa = (fa == 0.0f || plateau) ? tf[3 * n + i].x : -log1p(-ca.w);
+    const float sb = fb == 1.0f ? tf[3 * n + i + 1].x : plateau ? sa : -log1p(-cb.w);
+    const int up = cb.w >= ca.w;
+    const float4 ce = up ? ca : cb, co = up ? cb : ca;
+    const float se = up ? sa : sb, so = up ? sb : sa;
     const light_t fe = light_absorbed(ce, flags), fo = light_absorbed(co, flags);
-    if (co.w == ce.w) { /* a plateau of the opacity: one log */
-        const light_t de = se * fe, dob = se * fo;
-        *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
-        *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
-        return (0.5f * (b - a)) * (de + dob);
-    }
-    const float so = -log1p(-co.w);
-    const float qe = 1.0f - ce.w;
-    const float2 m = log_moments((co.w - ce.w) / qe, (1.0f - co.w) / qe, so - se);
     const light_t de = se * fe, dob = so * fo;
     *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
     *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
+    if (co.w == ce.w) /* a constant opacity: the colour's mean */
+        return (0.5f * (b - a)) * (de + dob);
+    const float qe = 1.0f - ce.w;
+    const float2 m = log_moments((co.w - ce.w) / qe, (1.0f - co.w) / qe, so - se);
     return (b - a) * (fe * (se + m.x) + (fo - fe) * (0.5f * se + m.y));
 }
 
