@@ -194,10 +194,10 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
 }
 
 /* The optical depth of the segment [ta, tb] of the ray p + t d (len voxels long, per_t voxels per
- * unit of t; xo, xd the ray in voxel coordinates) whose ends have the values va, vb:
+ * unit of t; xo, xd the ray in voxel coordinates) whose ends have the values va, vb, behind
+ * d_before of optical depth (the least over the channels) on the way to the light:
  * segment_depth, refined where the value's departure from a straight line within the segment
- * would shift the extinction. A piece
- * is a candidate for a split at a new sample
+ * would shift the extinction. A piece is a candidate for a split at a new sample
  *  - where the ray crosses a plane of voxel centres (the trilinear interpolant's kinks, an error
  *    of first order in the piece's length) and the extinction varies along the piece by more
  *    than SEG_KINK_DEPTH of optical depth, at that crossing: past the kinks the pieces are smooth,
@@ -208,7 +208,10 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
  * by more than SEG_REFINE_TOL in some channel, each half is a candidate in turn (depth-first,
  * with an explicit stack, at most SEG_REFINE_LEVELS deep); where they agree, the halves are
  * kept and the refinement stops there: most candidates are smooth pieces over a steep part of
- * the transfer function, which the first split already shows to be resolved. */
+ * the transfer function, which the first split already shows to be resolved. The three
+ * thresholds are multiplied by exp(d_before): an error e in this segment's depth moves the
+ * shadow factor by at most e exp(-d_before), so each stands for the same error in the factor,
+ * which is what the bounds and the images measure, wherever the segment lies. */
 #define SEG_REFINE_LEVELS 3
 #define SEG_REFINE_DEPTH 4e-3f
 #define SEG_KINK_DEPTH 1e-3f
@@ -217,7 +220,8 @@ inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
 #endif
 inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
                                uint flags, float3 p, float3 d, float3 xo, float3 xd, float ta,
-                               float tb, float va, float vb, float len, float per_t)
+                               float tb, float va, float vb, float len, float per_t,
+                               float d_before)
 {
     /* The pieces still to do after the current one: their ends, values at the ends, lengths,
      * depths, spreads and levels (each starts where the one above it ends). A split divides a
@@ -230,13 +234,20 @@ inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *t
     float spread;
     light_t dd = segment_depth(tf, n, va, vb, len, flags, &spread);
     light_t D = (light_t)(0.0f);
+    /* The thresholds in optical depth, scaled by the transmittance the light keeps to the
+     * segment (exp of d_before, computed where first needed). */
+    float scale = 0.0f;
     for (;;) {
         /* The current piece: [ta, tb], len voxels, values va, vb, depth dd and its spread. */
         float tm = -1.0f;
         if (level < SEG_REFINE_LEVELS && spread > SEG_KINK_DEPTH) {
-            tm = seg_kink(g, xo, xd, ta, tb);
-            if (tm < 0.0f && spread > SEG_REFINE_DEPTH)
-                tm = 0.5f * (ta + tb);
+            if (scale == 0.0f)
+                scale = exp(d_before);
+            if (spread > SEG_KINK_DEPTH * scale) {
+                tm = seg_kink(g, xo, xd, ta, tb);
+                if (tm < 0.0f && spread > SEG_REFINE_DEPTH * scale)
+                    tm = 0.5f * (ta + tb);
+            }
         }
         if (tm >= 0.0f) {
             const float vm = sample_volume(vol, g, p + tm * d);
@@ -244,7 +255,7 @@ inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *t
             float s_l, s_r;
             const light_t d_l = segment_depth(tf, n, va, vm, len_l, flags, &s_l);
             const light_t d_r = segment_depth(tf, n, vm, vb, len_r, flags, &s_r);
-            if (light_max(fabs(d_l + d_r - dd)) > SEG_REFINE_TOL) {
+            if (light_max(fabs(d_l + d_r - dd)) > SEG_REFINE_TOL * scale) {
                 ++top;
                 st_t[top] = tb;
                 st_v[top] = vb;
@@ -326,7 +337,7 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
         const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
         const float ta = t_start + (float)k * h;
         const light_t y = segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, ta, ta + h,
-                                          v_k, v_next, h_vox, per_t) - comp;
+                                          v_k, v_next, h_vox, per_t, light_min(D)) - comp;
         const light_t s = D + y;
         comp = (s - D) - y;
         D = s;
@@ -343,7 +354,7 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
             v_k = sample_volume(vol, g, p + t_k * d);
         const float v_end = sample_volume(vol, g, p + t_end * d);
         D += segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, t_k, t_end, v_k, v_end,
-                             last * per_t, per_t) - comp;
+                             last * per_t, per_t, light_min(D)) - comp;
     }
     return light_rgb(exp(-D));
 }

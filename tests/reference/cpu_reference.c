@@ -544,15 +544,17 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
  * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
  * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
  * candidates in turn (recursively, at most 3 deep) only where they differ from it by more than
- * 1e-5 in some channel. */
+ * 1e-5 in some channel; every threshold times scale, 1 over the transmittance the light keeps to
+ * the segment (an error in its depth moves the shadow factor by that fraction of it). */
 static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
                             float ta, float tb, float va, float vb, float len, float per_t,
-                            int level, const float f[3], float spread, double D[3])
+                            int level, const float f[3], float spread, float scale,
+                            double D[3])
 {
     float tm = -1.0f;
-    if (level < 3 && spread > 1e-3f) {
+    if (level < 3 && spread > 1e-3f * scale) {
         tm = kink(P, xo, xd, ta, tb);
-        if (tm < 0.0f && spread > 4e-3f)
+        if (tm < 0.0f && spread > 4e-3f * scale)
             tm = 0.5f * (ta + tb);
     }
     if (tm >= 0.0f) {
@@ -563,9 +565,11 @@ static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const 
         segment(P, vm, vb, len_r, fr, &sr);
         for (int ch = 0; ch < 3; ++ch)
             diff = fmaxf(diff, fabsf(fl[ch] + fr[ch] - f[ch]));
-        if (diff > 1e-5f) {
-            segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl, D);
-            segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr, D);
+        if (diff > 1e-5f * scale) {
+            segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl,
+                            scale, D);
+            segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr,
+                            scale, D);
             return;
         }
         for (int ch = 0; ch < 3; ++ch)
@@ -616,7 +620,10 @@ static v3 shadow(const prep *P, v3 p)
         float va = sample(P, qa), vb = sample(P, qb), len = k < n_full ? h_vox : last * (h_vox / h);
         float f[3], spread;
         segment(P, va, vb, len, f, &spread);
-        segment_refined(P, p, d, xo, xd, ta_k, tb_k, va, vb, len, h_vox / h, 0, f, spread, D);
+        /* the thresholds scaled by the transmittance the light keeps to the segment */
+        float scale = expf((float)fmin(D[0], fmin(D[1], D[2])));
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, va, vb, len, h_vox / h, 0, f, spread, scale,
+                        D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
