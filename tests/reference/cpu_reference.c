@@ -544,7 +544,7 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
  * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
  * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
  * candidates in turn (recursively, at most 3 deep) only where they differ from it by more than
- * 1e-5 in some channel; every threshold times scale, 1 over the transmittance the light keeps to
+ * 3e-5 in some channel; every threshold times scale, 1 over the transmittance the light keeps to
  * the segment (an error in its depth moves the shadow factor by that fraction of it). */
 static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
                             float ta, float tb, float va, float vb, float len, float per_t,
@@ -565,7 +565,7 @@ static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const 
         segment(P, vm, vb, len_r, fr, &sr);
         for (int ch = 0; ch < 3; ++ch)
             diff = fmaxf(diff, fabsf(fl[ch] + fr[ch] - f[ch]));
-        if (diff > 1e-5f * scale) {
+        if (diff > 3e-5f * scale) {
             segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl,
                             scale, D);
             segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr,
