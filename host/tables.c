@@ -19,24 +19,39 @@ float umbra__voxel_world(umbra_renderer r)
 
 /* The integral over table interval i (from entry i to i + 1, in table units) of the extinction
  * -ln(1 - a) (a at most 1 - 2^-24, kernels/common.cl) times 1 - t_c for c = r, g, b and times 1
- * (grey), the entries interpolated linearly: composite three-point Gauss in double over 16
- * pieces, which resolves the log's curvature up to the clamp. */
+ * (grey), the entries interpolated linearly: in closed form, in double, as piece_depth in
+ * kernels/shadow_reference.cl integrates parts of an interval (the same formula, so that whole
+ * and partial intervals agree): from the more transparent end e, with r = (a_o - a_e) /
+ * (1 - a_e), the mean extinction is s_e + phi(r) and the mean of tau times it s_e / 2 + psi(r),
+ * phi(r) = 1 + (1 - r) ln(1 - r) / r, psi(r) = (-ln(1 - r) (1 - 1 / r^2) + 1 / r + 1 / 2) / 2,
+ * summed as their series sum_k r^k / (k (k + 1)) and sum_k r^k / (k (k + 2)) below r = 1/2
+ * (60 terms: below 1e-20), where the closed forms cancel. */
 static void interval_depths(const float *e, double out[4])
 {
-    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
-    static const double weight[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-    out[0] = out[1] = out[2] = out[3] = 0.0;
-    for (int piece = 0; piece < 16; ++piece)
-        for (int q = 0; q < 3; ++q) {
-            double w = (piece + 0.5 + 0.5 * node[q]) / 16.0, c[4];
-            for (int k = 0; k < 4; ++k)
-                c[k] = e[k] + w * (e[4 + k] - e[k]);
-            double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
-            double sigma = -log1p(-a) * weight[q] / 16.0;
-            for (int k = 0; k < 3; ++k)
-                out[k] += sigma * (1.0 - c[k]);
-            out[3] += sigma;
+    const double amax = 0.99999994039535522;
+    double a0 = e[3] < amax ? e[3] : amax, a1 = e[7] < amax ? e[7] : amax;
+    const int up = a1 >= a0;
+    const float *ce = up ? e : e + 4, *co = up ? e + 4 : e;
+    const double ae = up ? a0 : a1, ao = up ? a1 : a0;
+    const double se = -log1p(-ae), so = -log1p(-ao), qe = 1.0 - ae;
+    const double r = (ao - ae) / qe;
+    double phi = 0.0, psi = 0.0;
+    if (r < 0.5) {
+        for (int k = 60; k >= 1; --k) {
+            phi = r * (phi + 1.0 / ((double)k * (k + 1)));
+            psi = r * (psi + 1.0 / ((double)k * (k + 2)));
         }
+    } else {
+        const double lr = so - se, ir = 1.0 / r;
+        phi = 1.0 - ((1.0 - ao) / qe) * lr * ir;
+        psi = 0.5 * (lr * (1.0 - ir * ir) + ir + 0.5);
+    }
+    const double m0 = se + phi, m1 = 0.5 * se + psi;
+    for (int k = 0; k < 3; ++k) {
+        const double fe = 1.0 - (double)ce[k], fo = 1.0 - (double)co[k];
+        out[k] = fe * m0 + (fo - fe) * m1;
+    }
+    out[3] = m0;
 }
 
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
@@ -46,14 +61,15 @@ static void interval_depths(const float *e, double out[4])
  * followed by 2 count float4: for each entry k, the sum over the intervals before it of
  * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
  * from which the exact reference takes the depth of whole table intervals with two loads and no
- * cancellation (kernels/shadow_reference.cl). */
+ * cancellation (kernels/shadow_reference.cl), then count float4 holding each entry's extinction
+ * -ln(1 - a) (a clamped to 1 - 2^-24) in x, so that it takes no log at a table entry. */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     const int light = step_voxels == 0.0f;
-    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 3 : 1);
+    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 4 : 1);
     float *t = malloc(bytes);
     if (!t)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
@@ -78,6 +94,13 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
                 for (int c = 0; c < 4; ++c)
                     sum[c] += d[c];
             }
+        }
+        float *e = t + 12 * (size_t)tf->count;
+        for (uint32_t k = 0; k < tf->count; ++k) {
+            double a = tf->rgba[4 * k + 3] < 0.99999994039535522 ? tf->rgba[4 * k + 3]
+                                                                 : 0.99999994039535522;
+            e[4 * k] = (float)-log1p(-a);
+            e[4 * k + 1] = e[4 * k + 2] = e[4 * k + 3] = 0.0f;
         }
     }
     umbra__release_mem(buf);

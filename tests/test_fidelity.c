@@ -614,6 +614,60 @@ static void test_fidelity_opaque_lit_surface_no_speckles(void **state)
     umbra_volume_release(vol);
 }
 
+/* A shadow ray whose length is a whole number of steps up to rounding: t_end = fl(n h) just
+ * above n h, so the final partial step is positive (last = t_end - n h, exact under the fused
+ * multiply-add the device may use) while its end t_start + n h rounds onto t_end. Its length in
+ * voxels was taken as h_vox last / h over a t-length of 0: 0 / 0, a NaN shadow factor (two NaN
+ * pixels in the 384^2 bonsai reference). Axis-aligned rays from points at x = 8 - fl(n h) in a
+ * homogeneous 16^3 box, for every n and four steps whose products round up: every factor must
+ * be (1 - a)^length. */
+static void test_fidelity_whole_steps_up_to_rounding(void **state)
+{
+    umbra_context ctx = *state;
+    enum { MAX_PTS = 512 };
+    static const float steps[] = {0.3f, 0.7f, 0.1f, 0.45f};
+    const float a = 0.3f;
+    umbra_volume vol = test_constant_volume(ctx, 16, 16, 16, 0.5f);
+    umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, a);
+    const umbra_light l = test_directional_light(-1.0f, 0.0f, 0.0f); /* toward +x */
+    umbra_renderer r = test_renderer_transmission(ctx, vol, tf, l, UMBRA_TRANSMISSION_GREY);
+    float pts[3 * MAX_PTS], rgb[3 * MAX_PTS], len[MAX_PTS];
+    int rounded_up = 0;
+    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; ++k) {
+        const float h = steps[k];
+        int n_pts = 0;
+        for (int n = 1; (double)n * h < 15.9 && n_pts < MAX_PTS; ++n) {
+            const float t = (float)n * h, x = 8.0f - t;
+            if (8.0f - x != t)
+                continue; /* the box face would not lie t from the point */
+            rounded_up += (double)t > (double)n * (double)h;
+            pts[3 * n_pts] = x;
+            pts[3 * n_pts + 1] = 0.3f;
+            pts[3 * n_pts + 2] = -0.2f;
+            len[n_pts++] = t;
+        }
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_REFERENCE;
+        sd.reference_step = h;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_query_shadow(r, pts, (size_t)n_pts, rgb), UMBRA_SUCCESS);
+        for (int i = 0; i < n_pts; ++i) {
+            const double want = pow(1.0 - a, len[i]);
+            for (int c = 0; c < 3; ++c)
+                if (!(fabs(rgb[3 * i + c] - want) <= 1e-5))
+                    fail_msg("step %g, path %.9g voxels (x = %.9g): factor %g, want %.7f", h,
+                             len[i], pts[3 * i], rgb[3 * i + c], want);
+        }
+    }
+    print_message("  %d paths of fl(n h) > n h, every factor finite and exact to 1e-5\n",
+                  rounded_up);
+    assert_true(rounded_up >= 20);
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(vol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -623,6 +677,7 @@ int main(void)
         cmocka_unit_test(test_fidelity_thin_cloud_fine_steps),
         cmocka_unit_test(test_fidelity_random_points_structured_volume),
         cmocka_unit_test(test_fidelity_opaque_lit_surface_no_speckles),
+        cmocka_unit_test(test_fidelity_whole_steps_up_to_rounding),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -300,6 +300,43 @@ static float walk_to_visible(const prep *P, walk *w, float t, float t_end)
     }
 }
 
+/* The integral over a table interval (table units) between the entries e0 and e1 (RGBA) of the
+ * extinction -ln(1 - a) times 1 - t_c (c = r, g, b) and times 1 (grey), a and t linear between
+ * them, a at most 1 - 2^-24 (clamped at the entries): in double, from the substitution
+ * q = 1 - a. Over tau in [0, 1] from the more transparent end e, with x = 1 - (1 - a_o) /
+ * (1 - a_e) the relative fall of q: int -ln q = s_e + A(x), int tau (-ln q) = s_e / 2 + B(x),
+ * A(x) = 1 + (1 - x) ln(1 - x) / x, B(x) = (-ln(1 - x) (1 - 1 / x^2) + 1 / x + 1 / 2) / 2, summed
+ * as their Taylor series for x < 1/2 where those cancel. *s_e, *s_o: the ends' extinctions
+ * -ln(1 - a) (if not NULL). */
+static void linear_extinction(const float *e0, const float *e1, double out[4], double *s_e,
+                              double *s_o)
+{
+    const double amax = 0.99999994039535522;
+    double a0 = e0[3] < amax ? e0[3] : amax, a1 = e1[3] < amax ? e1[3] : amax;
+    const float *ce = a1 >= a0 ? e0 : e1, *co = a1 >= a0 ? e1 : e0;
+    double ae = a1 >= a0 ? a0 : a1, ao = a1 >= a0 ? a1 : a0;
+    double se = -log1p(-ae), so = -log1p(-ao), x = (ao - ae) / (1.0 - ae), A = 0.0, B = 0.0;
+    if (x < 0.5) {
+        double xk = 1.0;
+        for (int k = 1; k <= 60; ++k) {
+            xk *= x;
+            A += xk / ((double)k * (k + 1));
+            B += xk / ((double)k * (k + 2));
+        }
+    } else {
+        double L = so - se;
+        A = 1.0 - (1.0 - ao) / (1.0 - ae) * L / x;
+        B = 0.5 * (L * (1.0 - 1.0 / (x * x)) + 1.0 / x + 0.5);
+    }
+    for (int k = 0; k < 3; ++k)
+        out[k] = (1.0 - ce[k]) * (se + A) + (ce[k] - co[k]) * (0.5 * se + B);
+    out[3] = se + A;
+    if (s_e)
+        *s_e = se;
+    if (s_o)
+        *s_o = so;
+}
+
 static void prep_init(prep *P, const cpu_scene *s)
 {
     memset(P, 0, sizeof *P);
@@ -325,23 +362,8 @@ static void prep_init(prep *P, const cpu_scene *s)
     P->light_bricks = bricks(P, ltf, P->light_n);
     P->light_int = malloc((size_t)4 * (P->light_n - 1) * sizeof *P->light_int);
     if (P->light_int)
-        for (int i = 0; i + 1 < P->light_n; ++i) {
-            /* composite three-point Gauss over 16 pieces, in double */
-            static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
-            static const double gw[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-            double *o = P->light_int + 4 * i;
-            o[0] = o[1] = o[2] = o[3] = 0.0;
-            for (int q = 0; q < 48; ++q) {
-                double w = (q / 3 + 0.5 + 0.5 * gx[q % 3]) / 16.0, c[4];
-                for (int k = 0; k < 4; ++k)
-                    c[k] = ltf[4 * i + k] + w * (ltf[4 * i + 4 + k] - ltf[4 * i + k]);
-                double a = c[3] < 0.99999994039535522 ? c[3] : 0.99999994039535522;
-                double sg = -log1p(-a) * gw[q % 3] / 16.0;
-                for (int k = 0; k < 3; ++k)
-                    o[k] += sg * (1.0 - c[k]);
-                o[3] += sg;
-            }
-        }
+        for (int i = 0; i + 1 < P->light_n; ++i)
+            linear_extinction(ltf + 4 * i, ltf + 4 * i + 4, P->light_int + 4 * i, NULL, NULL);
     P->colored = s->opts.transmission == UMBRA_TRANSMISSION_COLORED;
     P->point = s->light.type == UMBRA_LIGHT_POINT;
     P->light_vec = P->point ? from(s->light.position) : norm(from(s->light.direction));
@@ -416,37 +438,44 @@ static void depth_rate(const prep *P, const float c[4], float out[3])
         out[ch] = sigma * (P->colored ? 1.0f - c[ch] : 1.0f);
 }
 
-/* Three-point Gauss over [a, b] (table units, within one interval) of the extinction rate per
- * channel, added to out; lo, hi take the outer nodes' range. A transparent interval adds 0 and
- * sets lo to 0, as the kernel does. */
+/* The integral over [a, b] (table units, within one interval) of the extinction rate per
+ * channel, added to out: linear_extinction between the interpolated ends, times b - a; lo, hi
+ * take the range of the ends' rates (the rate is monotonic in a). A transparent interval adds 0
+ * and sets lo to 0, as the kernel does. */
 static void piece(const prep *P, float a, float b, double out[3], float *lo, float *hi)
 {
     const int n = P->light_n;
-    const float last = (float)(n - 1);
     int i = (int)a < n - 2 ? (int)a : n - 2;
-    if (P->light_tf[4 * i + 3] == 0.0f && P->light_tf[4 * i + 7] == 0.0f) {
+    const float *t = P->light_tf + 4 * i;
+    if (t[3] == 0.0f && t[7] == 0.0f) {
         *lo = 0.0f;
         return;
     }
-    float m = 0.5f * (a + b), hw = 0.38729833f * (b - a), c[4], r[3];
-    for (int q = -1; q <= 1; ++q) {
-        lookup(P->light_tf, n, (m + (float)q * hw) / last, c);
-        depth_rate(P, c, r);
-        for (int ch = 0; ch < 3; ++ch) {
-            out[ch] += (b - a) / 18.0f * (q ? 5.0f : 8.0f) * r[ch];
-            if (q) {
-                *lo = fminf(*lo, r[ch]);
-                *hi = fmaxf(*hi, r[ch]);
-            }
-        }
+    float ca[4], cb[4];
+    for (int k = 0; k < 4; ++k) {
+        ca[k] = lerp(t[k], t[4 + k], a - (float)i);
+        cb[k] = lerp(t[k], t[4 + k], b - (float)i);
+    }
+    double m[4], sa, sb;
+    linear_extinction(ca, cb, m, &sa, &sb);
+    if (cb[3] < ca[3]) { /* s_e belongs to b */
+        double s = sa;
+        sa = sb;
+        sb = s;
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        out[ch] += (double)(b - a) * (P->colored ? m[ch] : m[3]);
+        float ra = (float)sa * (P->colored ? 1.0f - ca[ch] : 1.0f);
+        float rb = (float)sb * (P->colored ? 1.0f - cb[ch] : 1.0f);
+        *lo = fminf(*lo, fminf(ra, rb));
+        *hi = fmaxf(*hi, fmaxf(ra, rb));
     }
 }
 
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
- * the mean extinction over [v0, v1]: the partial table intervals at the ends by three-point
- * Gauss, the whole ones between from their integrals (light_int), as kernels/shadow_reference.cl;
- * *spread: the range of the extinction over the Gauss nodes and the whole intervals' mean,
- * times len. */
+ * the mean extinction over [v0, v1]: the partial table intervals at the ends and the whole ones
+ * between in closed form (piece, light_int), as kernels/shadow_reference.cl; *spread: the range
+ * of the extinction over the pieces' ends and the whole intervals' mean, times len. */
 static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
     const int n = P->light_n;
@@ -511,25 +540,41 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
     return best;
 }
 
-/* segment, split at a new sample (recursively, at most 3 deep) as kernels/shadow_reference.cl:
- * at a plane of voxel centres it crosses if the extinction varies along it by more than 1e-3 of
- * optical depth, else at its middle if by more than 4e-3. */
+/* segment (len voxels, depth f, spread) refined as kernels/shadow_reference.cl does: a
+ * candidate for a split at a new sample at a plane of voxel centres it crosses if the extinction
+ * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
+ * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
+ * candidates in turn (recursively, at most 3 deep) only where they differ from it by more than
+ * 3e-5 in some channel; every threshold times scale, 1 over the transmittance the light keeps to
+ * the segment (an error in its depth moves the shadow factor by that fraction of it). */
 static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
-                            float ta, float tb, float va, float vb, float per_t, int level,
+                            float ta, float tb, float va, float vb, float len, float per_t,
+                            int level, const float f[3], float spread, float scale,
                             double D[3])
 {
-    float f[3], spread;
-    segment(P, va, vb, (tb - ta) * per_t, f, &spread);
     float tm = -1.0f;
-    if (level < 3 && spread > 1e-3f) {
+    if (level < 3 && spread > 1e-3f * scale) {
         tm = kink(P, xo, xd, ta, tb);
-        if (tm < 0.0f && spread > 4e-3f)
+        if (tm < 0.0f && spread > 4e-3f * scale)
             tm = 0.5f * (ta + tb);
     }
     if (tm >= 0.0f) {
         float vm = sample(P, add(p, mul(d, tm)));
-        segment_refined(P, p, d, xo, xd, ta, tm, va, vm, per_t, level + 1, D);
-        segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, per_t, level + 1, D);
+        float len_l = clampf((tm - ta) * per_t, 0.0f, len), len_r = len - len_l;
+        float fl[3], fr[3], sl, sr, diff = 0.0f;
+        segment(P, va, vm, len_l, fl, &sl);
+        segment(P, vm, vb, len_r, fr, &sr);
+        for (int ch = 0; ch < 3; ++ch)
+            diff = fmaxf(diff, fabsf(fl[ch] + fr[ch] - f[ch]));
+        if (diff > 3e-5f * scale) {
+            segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl,
+                            scale, D);
+            segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr,
+                            scale, D);
+            return;
+        }
+        for (int ch = 0; ch < 3; ++ch)
+            D[ch] += (double)fl[ch] + fr[ch];
         return;
     }
     for (int ch = 0; ch < 3; ++ch)
@@ -565,14 +610,21 @@ static v3 shadow(const prep *P, v3 p)
     for (int k = 0; k <= n_full; ++k) {
         float ta_k = t_start + (float)k * h;
         float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
-        float seg = k < n_full ? h_vox : h_vox * (last / h);
         if (k == n_full && !(last > 0.0f))
             break;
         v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
         if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
             continue;
-        segment_refined(P, p, d, xo, xd, ta_k, tb_k, sample(P, qa), sample(P, qb),
-                        seg / (tb_k - ta_k), 0, D);
+        /* h_vox voxels a whole step, h_vox last / h the final one; its pieces divide that at
+         * h_vox / h voxels per unit of t (its t-length can round to 0, kernels/
+         * shadow_reference.cl) */
+        float va = sample(P, qa), vb = sample(P, qb), len = k < n_full ? h_vox : last * (h_vox / h);
+        float f[3], spread;
+        segment(P, va, vb, len, f, &spread);
+        /* the thresholds scaled by the transmittance the light keeps to the segment */
+        float scale = expf((float)fmin(D[0], fmin(D[1], D[2])));
+        segment_refined(P, p, d, xo, xd, ta_k, tb_k, va, vb, len, h_vox / h, 0, f, spread, scale,
+                        D);
         if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
             return mk(0, 0, 0);
     }
