@@ -83,11 +83,19 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_mid = tb.x + (float)k * h + 0.5f * seg;
             const float3 q = o + t_mid * d;
             const float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-            const light_t rho = -expm1(-light_depth(col, h_vox * (seg / h), flags));
-            const float r = umbra_random(seed, (uint)x, (uint)y, (uint)k);
-            c = select(c, fmin(c, (light_t)(ls_depth(S, o, t_mid))), CSSM_HIT(rho, r));
-            if (CSSM_ALL_SET(c))
-                break;
+            /* A transparent sample (alpha 0, common in visible cells) stops no photon: rho = 0
+             * is never > r, so its logarithms and random number are skipped. */
+            if (col.w > 0.0f) {
+                const light_t od = light_depth(col, h_vox * (seg / h), flags);
+                /* rho > r, i.e. 1 - exp(-od) > r, compared as od > -ln(1 - r): one logarithm
+                 * per segment instead of an exponential per channel (the two sides differ only
+                 * where rounding puts r within an ulp of rho, a measure-zero change). */
+                const float r = umbra_random(seed, (uint)x, (uint)y, (uint)k);
+                const float r_od = -log1p(-r);
+                c = select(c, fmin(c, (light_t)(ls_depth(S, o, t_mid))), CSSM_HIT(od, r_od));
+                if (CSSM_ALL_SET(c))
+                    break;
+            }
             ++k;
         }
     }

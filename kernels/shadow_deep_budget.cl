@@ -34,8 +34,12 @@
 #define DEEP_FIXED_BUF 64 /* the largest max_nodes host/shadow_deep.c accepts */
 #define DEEP_FIXED_DP 24
 
+/* Per buffered node also its optical depth tau and sqrt(v), the two factors of the error's
+ * weight: computed once when the node arrives instead of in every span error that covers it (the
+ * exact choice evaluates O(M^3) of them, each a logarithm and a square root per channel). */
 typedef struct DeepFixed {
     deep_node n[DEEP_FIXED_BUF];
+    light_t tau[DEEP_FIXED_BUF], sq[DEEP_FIXED_BUF];
     int cnt;
 } DeepFixed;
 
@@ -55,14 +59,15 @@ inline light_t deep_fixed_line(const deep_node *n, int a, int b, int l)
 /* Error of replacing the buffer between kept nodes a and b (indices into n, a < b; a = -1: no
  * kept node before b) by the line from a to b (by 1 for a = -1), integrated against
  * sqrt(v) dtau from a (error 0 there; tau 0 for a = -1) to b, largest over the channels. */
-inline float deep_fixed_span_error(const deep_node *n, int a, int b)
+inline float deep_fixed_span_error(const DeepFixed *f, int a, int b)
 {
+    const deep_node *n = f->n;
     light_t sum = (light_t)(0.0f), e_prev = (light_t)(0.0f);
-    light_t t_prev = a < 0 ? (light_t)(0.0f) : deep_fixed_tau(DEEP_VIS(n[a]));
+    light_t t_prev = a < 0 ? (light_t)(0.0f) : f->tau[a];
     for (int l = a + 1; l <= b; ++l) {
         light_t e = fabs(DEEP_VIS(n[l]) - deep_fixed_line(n, a, b, l));
-        light_t t = deep_fixed_tau(DEEP_VIS(n[l]));
-        sum += 0.5f * (e + e_prev) * (t - t_prev) * sqrt(DEEP_VIS(n[l]));
+        light_t t = f->tau[l];
+        sum += 0.5f * (e + e_prev) * (t - t_prev) * f->sq[l];
         e_prev = e;
         t_prev = t;
     }
@@ -84,7 +89,7 @@ inline void deep_fixed_reduce(DeepFixed *f, int keep)
         next[i] = (char)(i + 1);
     }
     for (int i = 0; i < m - 1; ++i)
-        cost[i] = deep_fixed_span_error(f->n, prev[i], next[i]);
+        cost[i] = deep_fixed_span_error(f, prev[i], next[i]);
     cost[m - 1] = UMBRA_INF; /* the end value stays */
     int head = 0;
     for (int left = m; left > keep; --left) {
@@ -100,13 +105,16 @@ inline void deep_fixed_reduce(DeepFixed *f, int keep)
         prev[b] = (char)a;
         cost[best] = UMBRA_INF;
         if (a >= 0)
-            cost[a] = deep_fixed_span_error(f->n, prev[a], b);
+            cost[a] = deep_fixed_span_error(f, prev[a], b);
         if (b < m - 1)
-            cost[b] = deep_fixed_span_error(f->n, a, next[b]);
+            cost[b] = deep_fixed_span_error(f, a, next[b]);
     }
     int c = 0;
-    for (int i = head; i < m; i = next[i])
-        f->n[c++] = f->n[i];
+    for (int i = head; i < m; i = next[i], ++c) {
+        f->n[c] = f->n[i];
+        f->tau[c] = f->tau[i];
+        f->sq[c] = f->sq[i];
+    }
     f->cnt = c;
 }
 
@@ -121,7 +129,7 @@ inline void deep_fixed_optimal(DeepFixed *f, int keep)
     float best_prev[DEEP_FIXED_DP], best_cur[DEEP_FIXED_DP];
     char parent[DEEP_FIXED_DP][DEEP_FIXED_DP]; /* [kept count - 1][last kept index] */
     for (int j = 0; j < m; ++j) {
-        best_prev[j] = j == 0 ? 0.0f : deep_fixed_span_error(f->n, -1, j);
+        best_prev[j] = j == 0 ? 0.0f : deep_fixed_span_error(f, -1, j);
         parent[0][j] = -1;
     }
     for (int k = 1; k < keep; ++k) {
@@ -134,7 +142,7 @@ inline void deep_fixed_optimal(DeepFixed *f, int keep)
                 for (int i = j - 1; i >= k - 1; --i) {
                     if (!(best_prev[i] < best))
                         continue;
-                    float e = best_prev[i] + deep_fixed_span_error(f->n, i, j);
+                    float e = best_prev[i] + deep_fixed_span_error(f, i, j);
                     if (e < best) {
                         best = e;
                         arg = (char)i;
@@ -153,7 +161,7 @@ inline void deep_fixed_optimal(DeepFixed *f, int keep)
         j = parent[k][j];
     }
     for (int k = 0; k < keep; ++k)
-        f->n[k] = f->n[idx[k]];
+        f->n[k] = f->n[idx[k]]; /* tau and sq are not needed after the exact choice */
     f->cnt = keep;
 }
 
@@ -161,6 +169,8 @@ inline void deep_fixed_add(DeepFixed *f, deep_node e)
 {
     if (f->cnt == DEEP_FIXED_BUF)
         deep_fixed_reduce(f, DEEP_FIXED_BUF - 1);
+    f->tau[f->cnt] = deep_fixed_tau(DEEP_VIS(e));
+    f->sq[f->cnt] = sqrt(DEEP_VIS(e));
     f->n[f->cnt++] = e;
 }
 
