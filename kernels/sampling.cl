@@ -1,13 +1,30 @@
 // SPDX-License-Identifier: Apache-2.0
 /* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
- * build time (UMBRA_SAMPLER_IMAGE): a float buffer with hand-written trilinear interpolation
- * (fastest on PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture
- * hardware on GPUs). Both clamp to the border voxels and put voxel centres at integer voxel
- * coordinates, so they agree to the filtering hardware's precision. */
+ * build time (UMBRA_SAMPLER_IMAGE): a buffer with hand-written trilinear interpolation (fastest on
+ * PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture hardware on GPUs).
+ * Both clamp to the border voxels and put voxel centres at integer voxel coordinates, so they
+ * agree to the filtering hardware's precision.
+ *
+ * Voxels stay in the volume's own type on the device (UMBRA_VOXEL_T: uchar, ushort, short or
+ * float, a build option from the volume), 1, 2 or 4 bytes each, and are normalised to [0,1]
+ * through the value range when read: n = clamp((s * image_scale - lo) * scale, 0, 1)
+ * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The buffer path normalises
+ * each of the eight corners before interpolating, exactly as the float volume did, so values
+ * outside a given range clamp before they blend. The image path's filter blends first: the host
+ * stores a normalised float image instead wherever that would differ (host/volume.c). */
 
 #ifndef UMBRA_SAMPLER_IMAGE
 #define UMBRA_SAMPLER_IMAGE 0
 #endif
+#ifndef UMBRA_VOXEL_T
+#define UMBRA_VOXEL_T float
+#endif
+
+/* A stored value (a raw voxel, or a UNORM image's value in [0,1]) mapped to [0,1]. */
+UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
+{
+    return clamp((s * g.image_scale - g.value_lo) * g.value_scale, 0.0f, 1.0f);
+}
 
 #if UMBRA_SAMPLER_IMAGE
 #define VOLUME_PARAM __read_only image3d_t vol
@@ -17,10 +34,16 @@ __constant sampler_t umbra_linear =
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 u = (p - g.box_min) / (g.box_max - g.box_min);
-    return read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x;
+    return voxel_normalise(g, read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x);
 }
 #else
-#define VOLUME_PARAM __global const float *restrict vol
+#define VOLUME_PARAM __global const UMBRA_VOXEL_T *restrict vol
+
+/* Voxel i (x fastest) of the buffer, normalised. The one place the buffer is read. */
+UMBRA_INLINE float voxel_load(VOLUME_PARAM, VolGeom g, size_t i)
+{
+    return voxel_normalise(g, convert_float(vol[i]));
+}
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
@@ -32,10 +55,10 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float c000 = vol[z0 + y0 + i0.x], c100 = vol[z0 + y0 + i1.x];
-    float c010 = vol[z0 + y1 + i0.x], c110 = vol[z0 + y1 + i1.x];
-    float c001 = vol[z1 + y0 + i0.x], c101 = vol[z1 + y0 + i1.x];
-    float c011 = vol[z1 + y1 + i0.x], c111 = vol[z1 + y1 + i1.x];
+    float c000 = voxel_load(vol, g, z0 + y0 + i0.x), c100 = voxel_load(vol, g, z0 + y0 + i1.x);
+    float c010 = voxel_load(vol, g, z0 + y1 + i0.x), c110 = voxel_load(vol, g, z0 + y1 + i1.x);
+    float c001 = voxel_load(vol, g, z1 + y0 + i0.x), c101 = voxel_load(vol, g, z1 + y0 + i1.x);
+    float c011 = voxel_load(vol, g, z1 + y1 + i0.x), c111 = voxel_load(vol, g, z1 + y1 + i1.x);
     float c00 = mix(c000, c100, f.x), c10 = mix(c010, c110, f.x);
     float c01 = mix(c001, c101, f.x), c11 = mix(c011, c111, f.x);
     return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
