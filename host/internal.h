@@ -138,6 +138,7 @@ struct umbra_volume_t {
                                 CL_UNORM_INT16 (int16 biased by 32768) or normalised CL_FLOAT */
     umbra_scalar_type stored_type; /* element type on the device (kernels' UMBRA_VOXEL_T) */
     float value_map[3];      /* UmbraFrame.value_map: stored value s -> clamp((s [2] - [0]) [1]) */
+    int clamps;              /* some stored value maps outside [0,1] (kernels' UMBRA_VOXEL_CLAMPS) */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
     /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
@@ -149,6 +150,11 @@ struct umbra_volume_t {
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
 #endif
+
+/* The volume's voxels normalised as the kernels normalise them, (s - value_map[0]) *
+ * value_map[1] clamped to [0,1] for each stored value s (an image's UNORM texels as the integers
+ * they encode), into out (count floats). Blocks. For the plain-C twin and tests. */
+umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */

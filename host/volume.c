@@ -269,8 +269,8 @@ static void convert_voxels(const void *src, umbra_scalar_type type, size_t first
 /* Creates v->data or v->image from the caller's voxels: straight from them where the device
  * stores the input as it is, else through a bounded staging buffer (a few MiB), never a
  * converted copy of the whole volume. Blocks until the data is on the device. */
-static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, stored_form form,
-                           double lo, double scale)
+static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, cl_mem filled,
+                           stored_form form, double lo, double scale)
 {
     umbra_context ctx = v->ctx;
     umbra_status st = UMBRA_SUCCESS;
@@ -280,6 +280,12 @@ static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, stored
     void *host = form == STORED_RAW ? (void *)desc->data : NULL;
     void *stage = NULL;
     cl_int err;
+    if (filled && form == STORED_RAW) {
+        /* desc->data is filled's mapping: the buffer already holds the voxels as stored. */
+        clRetainMemObject(filled);
+        v->data = filled;
+        return UMBRA_SUCCESS;
+    }
     if (ctx->sampler == UMBRA_SAMPLER_IMAGE) {
         cl_image_format fmt = {CL_R, v->stored_type == UMBRA_UINT8    ? CL_UNORM_INT8
                                      : v->stored_type == UMBRA_UINT16 ? CL_UNORM_INT16
@@ -293,8 +299,16 @@ static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, stored
         v->image = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | direct, &fmt, &idesc, host, &err);
         UMBRA_CL_CHECK(err, "clCreateImage(volume)");
     } else {
-        v->data = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | direct, count * esize, host, &err);
+        /* One element more than the voxels: the sampler reads voxels in x pairs (vload2), and
+         * the pair of the last voxel reads one beyond it, with weight 0. */
+        v->data = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY, (count + 1) * esize, NULL, &err);
         UMBRA_CL_CHECK(err, "clCreateBuffer(volume)");
+        const float zero = 0.0f; /* a finite pad: weight 0 times anything else could be NaN */
+        UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->data, CL_TRUE, count * esize, esize, &zero, 0,
+                                      NULL, NULL));
+        if (form == STORED_RAW)
+            UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->data, CL_TRUE, 0, count * esize, host, 0,
+                                          NULL, NULL));
     }
     if (form == STORED_RAW)
         goto fail; /* done: st is UMBRA_SUCCESS */
@@ -325,7 +339,8 @@ fail:
     return st;
 }
 
-static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *desc,
+/* filled: NULL, or a buffer sampler's buffer (of desc->type) whose mapping desc->data is. */
+static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *desc, cl_mem filled,
                                   umbra_volume *out)
 {
     umbra_status st = validate(ctx, desc);
@@ -482,6 +497,7 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
             form = STORED_NORMALISED;
     } else if (desc->type == UMBRA_FLOAT32 && !float_ok)
         form = STORED_NORMALISED;
+    v->clamps = form != STORED_NORMALISED && clamps;
     if (form == STORED_NORMALISED) {
         v->stored_type = UMBRA_FLOAT32;
         v->value_map[0] = 0.0f;
@@ -510,7 +526,7 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
             tables[t][i] = x;
         }
 
-    if ((st = upload(v, desc, form, lo, scale)) != UMBRA_SUCCESS)
+    if ((st = upload(v, desc, filled, form, lo, scale)) != UMBRA_SUCCESS)
         goto fail;
     v->device_bytes = count * umbra_scalar_type_size(v->stored_type);
     free(intervals);
@@ -536,7 +552,114 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_volume_create: ctx %p, desc %p: neither may be NULL",
                            (void *)ctx, (void *)desc);
-    return volume_create(ctx, desc, out);
+    return volume_create(ctx, desc, NULL, out);
+}
+
+umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_desc *desc,
+                                        umbra_volume_fill_fn fill, void *user, umbra_volume *out)
+{
+    const char *fn = "umbra_volume_create_filled";
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", fn);
+    *out = NULL;
+    if (!ctx || !desc || !fill)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: ctx %p, desc %p, fill %p: none may be NULL", fn, (void *)ctx,
+                           (void *)desc, (void *)(uintptr_t)fill);
+    if (desc->struct_size == sizeof *desc && desc->data)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->data must be NULL: fill writes the voxels", fn);
+    /* validate() wants data: a stand-in until the real pointer is known. */
+    umbra_volume_desc d = *desc;
+    d.data = &d;
+    umbra_status st = validate(ctx, &d);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    const size_t bytes = (size_t)d.dims[0] * d.dims[1] * d.dims[2] * umbra_scalar_type_size(d.type);
+    cl_mem buf = NULL;
+    void *host = NULL, *mapped = NULL;
+    cl_int err;
+    if (ctx->sampler == UMBRA_SAMPLER_BUFFER) {
+        /* The device's own buffer, mapped: on a CPU device the mapping is the buffer itself,
+         * so the voxels are written once, where the kernels read them. */
+        buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR,
+                             bytes + umbra_scalar_type_size(d.type), NULL, &err);
+        if (err == CL_SUCCESS)
+            mapped = clEnqueueMapBuffer(ctx->queue, buf, CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION,
+                                        0, bytes + umbra_scalar_type_size(d.type), 0, NULL, NULL,
+                                        &err);
+        if (err == CL_SUCCESS) /* the sampler's pad element (see upload) */
+            memset((unsigned char *)mapped + bytes, 0, umbra_scalar_type_size(d.type));
+        if (err != CL_SUCCESS) {
+            int oom = err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
+                      err == CL_OUT_OF_HOST_MEMORY;
+            st = umbra__fail(ctx, oom ? UMBRA_ERROR_OUT_OF_MEMORY : UMBRA_ERROR_OPENCL,
+                             "%s: a mapped buffer of %zu bytes for %u x %u x %u voxels: %s (%d)",
+                             fn, bytes, d.dims[0], d.dims[1], d.dims[2], umbra__cl_error_name(err),
+                             (int)err);
+            goto fail;
+        }
+        d.data = mapped;
+    } else {
+        /* An image is made from host memory: the voxels go there first. */
+        host = malloc(bytes);
+        if (!host) {
+            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "%s: out of host memory for %zu bytes of voxels", fn, bytes);
+            goto fail;
+        }
+        d.data = host;
+    }
+    if ((st = fill(user, (void *)d.data, bytes)) != UMBRA_SUCCESS)
+        goto fail;
+    st = volume_create(ctx, &d, buf, out);
+fail:
+    if (mapped) {
+        /* The kernels that will read the buffer are queued after the unmap. */
+        err = clEnqueueUnmapMemObject(ctx->queue, buf, mapped, 0, NULL, NULL);
+        if (err != CL_SUCCESS && st == UMBRA_SUCCESS) {
+            umbra_volume_release(*out);
+            *out = NULL;
+            st = umbra__fail(ctx, UMBRA_ERROR_OPENCL, "%s: clEnqueueUnmapMemObject: %s (%d)", fn,
+                             umbra__cl_error_name(err), (int)err);
+        }
+    }
+    if (buf)
+        clReleaseMemObject(buf);
+    free(host);
+    return st;
+}
+
+umbra_status umbra__volume_read_normalised(umbra_volume v, float *out)
+{
+    umbra_context ctx = v->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const size_t count = (size_t)v->dims[0] * v->dims[1] * v->dims[2];
+    const size_t esize = umbra_scalar_type_size(v->stored_type);
+    /* Floats read in place; narrower types into the end of out, so that the conversion running
+     * forwards never overwrites a value it has yet to read. */
+    unsigned char *raw = (unsigned char *)out + count * (sizeof *out - esize);
+    if (v->data) {
+        UMBRA_CL(clEnqueueReadBuffer(ctx->queue, v->data, CL_TRUE, 0, count * esize, raw, 0, NULL,
+                                     NULL));
+    } else {
+        size_t origin[3] = {0, 0, 0}, region[3] = {v->dims[0], v->dims[1], v->dims[2]};
+        UMBRA_CL(clEnqueueReadImage(ctx->queue, v->image, CL_TRUE, origin, region, 0, 0, raw, 0,
+                                    NULL, NULL));
+    }
+    for (size_t i = 0; i < count; ++i) {
+        float s;
+        switch (v->stored_type) {
+        case UMBRA_UINT8: s = (float)raw[i]; break;
+        case UMBRA_UINT16: { uint16_t u; memcpy(&u, raw + 2 * i, 2); s = (float)u; break; }
+        case UMBRA_INT16: { int16_t u; memcpy(&u, raw + 2 * i, 2); s = (float)u; break; }
+        default: memcpy(&s, raw + 4 * i, 4); break;
+        }
+        float x = (s - v->value_map[0]) * v->value_map[1];
+        out[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
+    }
+fail:
+    return st;
 }
 
 umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)

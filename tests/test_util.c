@@ -92,42 +92,10 @@ double test_path_in_box(const double p[3], const double dir[3], const double hal
 
 float *test_read_voxels(umbra_volume vol)
 {
-    /* The device holds the volume's own type (host/volume.c): read it back and normalise each
-     * voxel as the kernels do, (s - value_map[0]) * value_map[1] clamped to [0,1], for stored
-     * values s (an image's UNORM texels as the integers they encode). */
     const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
-    const size_t esize = umbra_scalar_type_size(vol->stored_type);
     float *out = malloc(count * sizeof *out);
-    unsigned char *raw = malloc(count * esize);
-    cl_int err;
     assert_non_null(out);
-    assert_non_null(raw);
-    if (vol->data) {
-        err = clEnqueueReadBuffer(vol->ctx->queue, vol->data, CL_TRUE, 0, count * esize, raw, 0,
-                                  NULL, NULL);
-    } else {
-        size_t origin[3] = {0, 0, 0};
-        size_t region[3];
-        region[0] = vol->dims[0];
-        region[1] = vol->dims[1];
-        region[2] = vol->dims[2];
-        assert_non_null(vol->image);
-        err = clEnqueueReadImage(vol->ctx->queue, vol->image, CL_TRUE, origin, region, 0, 0, raw,
-                                 0, NULL, NULL);
-    }
-    assert_int_equal(err, CL_SUCCESS);
-    for (size_t i = 0; i < count; ++i) {
-        float s;
-        switch (vol->stored_type) {
-        case UMBRA_UINT8: s = (float)((const uint8_t *)raw)[i]; break;
-        case UMBRA_UINT16: s = (float)((const uint16_t *)raw)[i]; break;
-        case UMBRA_INT16: s = (float)((const int16_t *)raw)[i]; break;
-        default: memcpy(&s, raw + 4 * i, 4); break;
-        }
-        float x = (s - vol->value_map[0]) * vol->value_map[1];
-        out[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
-    }
-    free(raw);
+    assert_int_equal(umbra__volume_read_normalised(vol, out), UMBRA_SUCCESS);
     return out;
 }
 
