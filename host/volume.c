@@ -528,7 +528,8 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
 
     if ((st = upload(v, desc, filled, form, lo, scale)) != UMBRA_SUCCESS)
         goto fail;
-    v->device_bytes = count * umbra_scalar_type_size(v->stored_type);
+    /* The buffer has one pad element (see upload). */
+    v->device_bytes = (count + (v->data ? 1 : 0)) * umbra_scalar_type_size(v->stored_type);
     free(intervals);
     *out = v;
     return UMBRA_SUCCESS;
