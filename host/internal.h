@@ -81,6 +81,7 @@ struct umbra_context_t {
     int profiling;                      /* queue has CL_QUEUE_PROFILING_ENABLE: device times */
     int is_cpu;
     int has_float_r_image3d;
+    int has_unorm8_r_image3d, has_unorm16_r_image3d; /* CL_R 3D images of CL_UNORM_INT8 / 16 */
     umbra_sampler_kind sampler;
     char device_name[600];              /* "platform / device": two 256-byte names */
     umbra__program *programs;           /* cache: one entry per (sources, options) */
@@ -131,8 +132,13 @@ struct umbra_volume_t {
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
     float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
                                 brick-major, x fastest (kernels/umbra_shared.h) */
-    cl_mem data;             /* normalised float32 voxels (buffer sampler) */
-    cl_mem image;            /* CL_R / CL_FLOAT 3D image (image sampler), or NULL */
+    cl_mem data;             /* voxels for the buffer sampler: the input type's raw values, or
+                                normalised float32 (stored_type FLOAT32 with value_map 0, 1, 1) */
+    cl_mem image;            /* 3D image (image sampler), or NULL: CL_R of CL_UNORM_INT8 /
+                                CL_UNORM_INT16 (int16 biased by 32768) or normalised CL_FLOAT */
+    umbra_scalar_type stored_type; /* element type on the device (kernels' UMBRA_VOXEL_T) */
+    float value_map[3];      /* UmbraFrame.value_map: stored value s -> clamp((s [2] - [0]) [1]) */
+    int clamps;              /* some stored value maps outside [0,1] (kernels' UMBRA_VOXEL_CLAMPS) */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
     /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
@@ -144,6 +150,11 @@ struct umbra_volume_t {
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
 #endif
+
+/* The volume's voxels normalised as the kernels normalise them, (s - value_map[0]) *
+ * value_map[1] clamped to [0,1] for each stored value s (an image's UNORM texels as the integers
+ * they encode), into out (count floats). Blocks. For the plain-C twin and tests. */
+umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */

@@ -1,13 +1,37 @@
 // SPDX-License-Identifier: Apache-2.0
 /* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
- * build time (UMBRA_SAMPLER_IMAGE): a float buffer with hand-written trilinear interpolation
- * (fastest on PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture
- * hardware on GPUs). Both clamp to the border voxels and put voxel centres at integer voxel
- * coordinates, so they agree to the filtering hardware's precision. */
+ * build time (UMBRA_SAMPLER_IMAGE): a buffer with hand-written trilinear interpolation (fastest on
+ * PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture hardware on GPUs).
+ * Both clamp to the border voxels and put voxel centres at integer voxel coordinates, so they
+ * agree to the filtering hardware's precision.
+ *
+ * Voxels stay in the volume's own type on the device (UMBRA_VOXEL_T: uchar, ushort, short or
+ * float, a build option from the volume), 1, 2 or 4 bytes each, and are normalised to [0,1]
+ * through the value range when read: n = clamp((s * image_scale - lo) * scale, 0, 1)
+ * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The mapping is linear
+ * until it clamps, so where no voxel lies outside the value range (UMBRA_VOXEL_CLAMPS 0, a build
+ * option from the volume) the sampler blends the stored values and maps the result once, which
+ * keeps the buffer path as fast as the float volume was (per-corner mapping cost 20% of a
+ * frame); where a given range clamps voxels, the buffer path maps each of the eight corners
+ * before blending, so values outside the range clamp before they blend, as the float volume
+ * did. The image path's filter always blends first: the host stores a normalised float image
+ * instead wherever that would differ (host/volume.c). */
 
 #ifndef UMBRA_SAMPLER_IMAGE
 #define UMBRA_SAMPLER_IMAGE 0
 #endif
+#ifndef UMBRA_VOXEL_T
+#define UMBRA_VOXEL_T float
+#endif
+#ifndef UMBRA_VOXEL_CLAMPS
+#define UMBRA_VOXEL_CLAMPS 1
+#endif
+
+/* A stored value (a raw voxel, or a UNORM image's value in [0,1]) mapped to [0,1]. */
+UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
+{
+    return clamp((s * g.image_scale - g.value_lo) * g.value_scale, 0.0f, 1.0f);
+}
 
 #if UMBRA_SAMPLER_IMAGE
 #define VOLUME_PARAM __read_only image3d_t vol
@@ -17,10 +41,41 @@ __constant sampler_t umbra_linear =
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 u = (p - g.box_min) / (g.box_max - g.box_min);
-    return read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x;
+    return voxel_normalise(g, read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x);
 }
 #else
-#define VOLUME_PARAM __global const float *restrict vol
+#define VOLUME_PARAM __global const UMBRA_VOXEL_T *restrict vol
+
+/* Voxel i (x fastest) of the buffer, ready to blend: normalised where the range clamps, else
+ * as stored (voxel_blended maps the blend). The one place the buffer is read. */
+UMBRA_INLINE float voxel_load(VOLUME_PARAM, VolGeom g, size_t i)
+{
+#if UMBRA_VOXEL_CLAMPS
+    return voxel_normalise(g, convert_float(vol[i]));
+#else
+    return convert_float(vol[i]);
+#endif
+}
+
+UMBRA_INLINE float2 voxel_load2(VOLUME_PARAM, VolGeom g, size_t i)
+{
+#if UMBRA_VOXEL_CLAMPS
+    float2 s = convert_float2(vload2(0, vol + i));
+    return (float2)(voxel_normalise(g, s.x), voxel_normalise(g, s.y));
+#else
+    return convert_float2(vload2(0, vol + i));
+#endif
+}
+
+/* A blend of voxel_load values, normalised. */
+UMBRA_INLINE float voxel_blended(VolGeom g, float b)
+{
+#if UMBRA_VOXEL_CLAMPS
+    return b;
+#else
+    return voxel_normalise(g, b);
+#endif
+}
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
@@ -32,13 +87,11 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float c000 = vol[z0 + y0 + i0.x], c100 = vol[z0 + y0 + i1.x];
-    float c010 = vol[z0 + y1 + i0.x], c110 = vol[z0 + y1 + i1.x];
-    float c001 = vol[z1 + y0 + i0.x], c101 = vol[z1 + y0 + i1.x];
-    float c011 = vol[z1 + y1 + i0.x], c111 = vol[z1 + y1 + i1.x];
-    float c00 = mix(c000, c100, f.x), c10 = mix(c010, c110, f.x);
-    float c01 = mix(c001, c101, f.x), c11 = mix(c011, c111, f.x);
-    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+    float2 c0 = voxel_load2(vol, g, z0 + y0 + i0.x), c1 = voxel_load2(vol, g, z0 + y1 + i0.x);
+    float2 c2 = voxel_load2(vol, g, z1 + y0 + i0.x), c3 = voxel_load2(vol, g, z1 + y1 + i0.x);
+    float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
+    float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
+    return voxel_blended(g, mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z));
 }
 #endif
 

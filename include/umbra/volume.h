@@ -70,9 +70,24 @@ typedef struct umbra_volume_desc {
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
-/* Copies the data to the device. Blocks until the upload is done. */
+/* Copies the data to the device, in its own type (1, 2 or 4 bytes per voxel; see
+ * umbra_volume_info.device_bytes). Reads desc->data once, in parallel, and keeps no pointer to
+ * it. Blocks until the upload is done. */
 UMBRA_API umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
                                            umbra_volume *out);
+
+/* Writes the volume's voxels, dims[0]*dims[1]*dims[2] of desc->type, x fastest, into dst (bytes
+ * long, borrowed for the call). Returns UMBRA_SUCCESS, or a failure status it has recorded on the
+ * context (umbra_context_record_error), which umbra_volume_create_filled returns. */
+typedef umbra_status (*umbra_volume_fill_fn)(void *user, void *dst, size_t bytes);
+
+/* umbra_volume_create for voxels that are not in memory yet (a file being read): desc->data must
+ * be NULL, and fill(user, dst, bytes) writes them, once, where the device reads them where it can
+ * (the buffer sampler's mapped buffer: on a CPU device the voxels then exist once, with no host
+ * copy), else into a host buffer freed before return. Blocks. */
+UMBRA_API umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_desc *desc,
+                                                  umbra_volume_fill_fn fill, void *user,
+                                                  umbra_volume *out);
 
 typedef struct umbra_volume_info {
     uint32_t dims[3];
@@ -81,7 +96,9 @@ typedef struct umbra_volume_info {
     float value_min, value_max;
     uint32_t brick_size;
     uint32_t brick_counts[3];
-    size_t device_bytes;     /* device memory held by the volume and its brick table */
+    size_t device_bytes;     /* device memory held by the voxels: the input type's size per
+                                voxel (an image sampler without a UNORM format for it, or a
+                                float range too wide for float math, stores 4) */
     int transform_given;     /* nonzero if the volume was made with an index-to-world transform */
     float origin[3];         /* world position of voxel (0, 0, 0)'s centre (also for the centred
                                 box: (0.5 - dims/2) * spacing) */
