@@ -345,17 +345,9 @@ static int read_back(umbra_context ctx, bench_volume *out)
     out->voxels = malloc(n * sizeof *out->voxels);
     if (!out->voxels)
         return -1;
-    cl_int err;
-    if (v->data) {
-        err = clEnqueueReadBuffer(ctx->queue, v->data, CL_TRUE, 0, n * sizeof *out->voxels,
-                                  out->voxels, 0, NULL, NULL);
-    } else {
-        size_t origin[3] = {0, 0, 0}, region[3] = {v->dims[0], v->dims[1], v->dims[2]};
-        err = clEnqueueReadImage(ctx->queue, v->image, CL_TRUE, origin, region, 0, 0, out->voxels,
-                                 0, NULL, NULL);
-    }
-    if (err != CL_SUCCESS) {
-        fprintf(stderr, "umbra-bench: reading the volume back failed (cl error %d)\n", (int)err);
+    if (umbra__slabs_read(v, out->voxels, sizeof *out->voxels) != UMBRA_SUCCESS) {
+        fprintf(stderr, "umbra-bench: reading the volume back failed: %s\n",
+                umbra_context_last_message(ctx));
         return -1;
     }
     return 0;

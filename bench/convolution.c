@@ -146,18 +146,10 @@ static umbra_volume load_carp(umbra_context ctx, const char *path, int k, char *
     uint32_t m[3] = {n[0] / k, n[1] / k, n[2] / k};
     v = malloc(count * sizeof *v);
     d = malloc((size_t)m[0] * m[1] * m[2] * sizeof *d);
-    cl_int err = CL_INVALID_VALUE;
-    if (v && d) {
-        if (full->data) {
-            err = clEnqueueReadBuffer(ctx->queue, full->data, CL_TRUE, 0, count * sizeof *v, v, 0,
-                                      NULL, NULL);
-        } else {
-            size_t origin[3] = {0, 0, 0}, region[3] = {n[0], n[1], n[2]};
-            err = clEnqueueReadImage(ctx->queue, full->image, CL_TRUE, origin, region, 0, 0, v, 0,
-                                     NULL, NULL);
-        }
-    }
-    if (err != CL_SUCCESS) {
+    umbra_status err = UMBRA_ERROR_OUT_OF_MEMORY;
+    if (v && d)
+        err = umbra__slabs_read(full, v, sizeof *v);
+    if (err != UMBRA_SUCCESS) {
         fprintf(stderr, "umbra-bench: reading %s back failed\n", path);
         goto done;
     }

@@ -90,6 +90,8 @@ struct umbra_context_t {
     umbra_error_callback callback;
     void *callback_user;
     atomic_uint_least64_t next_id;      /* source of volume / transfer-function ids */
+    uint64_t alloc_limit;               /* tests only (umbra__context_limit_alloc): a largest
+                                           allocation below the device's, 0 for none */
 };
 #endif
 
@@ -119,6 +121,10 @@ double umbra__now_ms(void);
 
 /* ---- volume ---------------------------------------------------------------------------------- */
 
+/* The most z-slabs a volume may be split into: each is a kernel parameter (kernels/sampling.cl
+ * spells out this many). */
+#define UMBRA__MAX_SLABS 8
+
 #ifndef __cplusplus
 struct umbra_volume_t {
     atomic_int refs;
@@ -131,8 +137,12 @@ struct umbra_volume_t {
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
     float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
                                 brick-major, x fastest (kernels/umbra_shared.h) */
-    cl_mem data;             /* normalised float32 voxels (buffer sampler) */
-    cl_mem image;            /* CL_R / CL_FLOAT 3D image (image sampler), or NULL */
+    /* The voxels on the device: normalised float32 in buffers (buffer sampler) or CL_R /
+     * CL_FLOAT 3D images (image sampler), in slab_count z-slabs; slab s holds the layers
+     * [s * slab_step, (s + 1) * slab_step] clipped to the grid (host/volume_slabs.c). */
+    cl_mem slabs[UMBRA__MAX_SLABS];
+    uint32_t slab_count;
+    uint32_t slab_step;
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
     /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
@@ -144,6 +154,42 @@ struct umbra_volume_t {
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
 };
 #endif
+
+/* What bounds a volume on a device: its largest allocation (lowered by the test knob below), its
+ * global memory and, for the image sampler, its largest 3D image (width, height, depth). */
+typedef struct umbra__device_limits {
+    uint64_t max_alloc;
+    uint64_t global_mem;
+    size_t image_max[3];
+} umbra__device_limits;
+
+/* Queries ctx's device; image_max is queried only when image is nonzero (else zeros).
+ * host/volume_slabs.c. */
+umbra_status umbra__device_limits_get(umbra_context ctx, int image, umbra__device_limits *out);
+
+/* Tests only: pretend ctx's device allocates at most bytes at once (0: the device's own limit),
+ * so that a small volume is split into slabs. Volumes created afterwards see it. */
+void umbra__context_limit_alloc(umbra_context ctx, uint64_t bytes);
+
+/* Splits dims (voxel_bytes per voxel) into the fewest z-slabs that each fit lim (one slab when
+ * the whole volume fits): *count slabs, slab s starting at layer s * *step (the step is dims[2]
+ * for one slab), *bytes on the device in all, aprons included. UMBRA_ERROR_OUT_OF_MEMORY with a
+ * message naming the sizes when the slabs would exceed the device's global memory, two layers
+ * exceed one allocation, or more than UMBRA__MAX_SLABS slabs would be needed;
+ * UMBRA_ERROR_UNSUPPORTED when a layer is wider or taller than the device's largest 3D image. */
+umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t voxel_bytes,
+                               int image, const umbra__device_limits *lim, uint32_t *count,
+                               uint32_t *step, uint64_t *bytes);
+
+/* Creates v's slabs (v->slab_count, v->slab_step set) from voxels, dims[0] * dims[1] * dims[2]
+ * values of voxel_bytes each, x fastest, copied: buffers, or 3D images of format fmt when fmt is
+ * not NULL. On failure the slabs made so far stay in v->slabs for umbra_volume_release. */
+umbra_status umbra__slabs_upload(umbra_context ctx, umbra_volume v, const void *voxels,
+                                 size_t voxel_bytes, const cl_image_format *fmt);
+
+/* Reads v's voxels back from its slabs into out (dims[0] * dims[1] * dims[2] values of
+ * voxel_bytes each, as the device holds them, x fastest). Blocks. */
+umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */

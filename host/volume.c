@@ -62,9 +62,11 @@ static umbra_status validate(umbra_context ctx, const umbra_volume_desc *d)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: dims %u x %u x %u: every size must be > 0", fn, d->dims[0],
                            d->dims[1], d->dims[2]);
-    if ((uint64_t)d->dims[0] * d->dims[1] * d->dims[2] > ((uint64_t)1 << 32))
+    /* A bound on what a caller can make large: 2^36 float voxels are 256 GiB, more than any
+     * device holds (the device's own memory is checked when the voxels are uploaded). */
+    if ((uint64_t)d->dims[0] * d->dims[1] * d->dims[2] > ((uint64_t)1 << 36))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: dims %u x %u x %u: more than 2^32 voxels", fn, d->dims[0],
+                           "%s: dims %u x %u x %u: more than 2^36 voxels", fn, d->dims[0],
                            d->dims[1], d->dims[2]);
     for (int a = 0; a < 3; ++a)
         if (!(d->spacing[a] > 0.0f) || !isfinite(d->spacing[a]))
@@ -222,6 +224,18 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     v->value_min = (float)lo;
     v->value_max = (float)hi;
 
+    /* Refused before the host copy is made when it cannot fit the device (the upload plans
+     * again: the query is cheap). */
+    {
+        umbra__device_limits lim;
+        uint32_t nslabs, step;
+        uint64_t bytes;
+        if ((st = umbra__device_limits_get(ctx, ctx->sampler == UMBRA_SAMPLER_IMAGE, &lim)) !=
+                UMBRA_SUCCESS ||
+            (st = umbra__slabs_plan(ctx, v->dims, sizeof *vox, ctx->sampler == UMBRA_SAMPLER_IMAGE,
+                                    &lim, &nslabs, &step, &bytes)) != UMBRA_SUCCESS)
+            goto fail;
+    }
     vox = malloc(count * sizeof *vox);
     size_t nbricks = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     v->brick_minmax = malloc(2 * nbricks * sizeof *v->brick_minmax);
@@ -237,24 +251,11 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
     compute_bricks(v, vox);
     compute_cells(v, vox);
 
-    cl_int err;
-    if (ctx->sampler == UMBRA_SAMPLER_IMAGE) {
-        cl_image_format fmt = {CL_R, CL_FLOAT};
-        cl_image_desc idesc;
-        memset(&idesc, 0, sizeof idesc);
-        idesc.image_type = CL_MEM_OBJECT_IMAGE3D;
-        idesc.image_width = v->dims[0];
-        idesc.image_height = v->dims[1];
-        idesc.image_depth = v->dims[2];
-        v->image = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, &fmt, &idesc,
-                                 vox, &err);
-        UMBRA_CL_CHECK(err, "clCreateImage(volume)");
-    } else {
-        v->data = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                 count * sizeof *vox, vox, &err);
-        UMBRA_CL_CHECK(err, "clCreateBuffer(volume)");
-    }
-    v->device_bytes = count * sizeof *vox;
+    const cl_image_format fmt = {CL_R, CL_FLOAT};
+    if ((st = umbra__slabs_upload(ctx, v, vox, sizeof *vox,
+                                  ctx->sampler == UMBRA_SAMPLER_IMAGE ? &fmt : NULL)) !=
+        UMBRA_SUCCESS)
+        goto fail;
     free(vox);
     *out = v;
     return UMBRA_SUCCESS;
@@ -307,10 +308,9 @@ void umbra_volume_release(umbra_volume v)
 {
     if (!v || atomic_fetch_sub(&v->refs, 1) > 1)
         return;
-    if (v->data)
-        clReleaseMemObject(v->data);
-    if (v->image)
-        clReleaseMemObject(v->image);
+    for (int s = 0; s < UMBRA__MAX_SLABS; ++s)
+        if (v->slabs[s])
+            clReleaseMemObject(v->slabs[s]);
     free(v->brick_minmax);
     free(v->cell_minmax);
     umbra_context_release(v->ctx);

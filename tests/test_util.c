@@ -94,22 +94,8 @@ float *test_read_voxels(umbra_volume vol)
 {
     const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
     float *out = malloc(count * sizeof *out);
-    cl_int err;
     assert_non_null(out);
-    if (vol->data) {
-        err = clEnqueueReadBuffer(vol->ctx->queue, vol->data, CL_TRUE, 0, count * sizeof *out, out,
-                                  0, NULL, NULL);
-    } else {
-        size_t origin[3] = {0, 0, 0};
-        size_t region[3];
-        region[0] = vol->dims[0];
-        region[1] = vol->dims[1];
-        region[2] = vol->dims[2];
-        assert_non_null(vol->image);
-        err = clEnqueueReadImage(vol->ctx->queue, vol->image, CL_TRUE, origin, region, 0, 0, out,
-                                 0, NULL, NULL);
-    }
-    assert_int_equal(err, CL_SUCCESS);
+    assert_int_equal(umbra__slabs_read(vol, out, sizeof *out), UMBRA_SUCCESS);
     return out;
 }
 

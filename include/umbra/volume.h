@@ -70,7 +70,10 @@ typedef struct umbra_volume_desc {
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
-/* Copies the data to the device. Blocks until the upload is done. */
+/* Copies the data to the device. Blocks until the upload is done. A volume larger than the
+ * device's largest allocation (or 3D image) is split into up to 8 z-slabs, drawn seamlessly;
+ * UMBRA_ERROR_OUT_OF_MEMORY, naming the sizes, when it would not fit the device's global memory
+ * or 8 slabs; at most 2^36 voxels. */
 UMBRA_API umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
                                            umbra_volume *out);
 
