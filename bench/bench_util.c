@@ -345,7 +345,7 @@ static int read_back(umbra_context ctx, bench_volume *out)
     out->voxels = malloc(n * sizeof *out->voxels);
     if (!out->voxels)
         return -1;
-    if (umbra__slabs_read(v, out->voxels, sizeof *out->voxels) != UMBRA_SUCCESS) {
+    if (umbra__volume_read_normalised(v, out->voxels) != UMBRA_SUCCESS) {
         fprintf(stderr, "umbra-bench: reading the volume back failed: %s\n",
                 umbra_context_last_message(ctx));
         return -1;

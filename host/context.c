@@ -180,16 +180,20 @@ static void describe_device(umbra_context ctx, const umbra_context_desc *desc)
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", pname, dname);
     ctx->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
 
-    ctx->has_float_r_image3d = 0;
+    ctx->has_float_r_image3d = ctx->has_unorm8_r_image3d = ctx->has_unorm16_r_image3d = 0;
     if (images) {
         cl_image_format formats[256];
         cl_uint nf = 0;
         if (clGetSupportedImageFormats(ctx->cl_ctx, CL_MEM_READ_ONLY, CL_MEM_OBJECT_IMAGE3D, 256,
                                        formats, &nf) == CL_SUCCESS) {
-            for (cl_uint i = 0; i < nf && i < 256; ++i)
-                if (formats[i].image_channel_order == CL_R &&
-                    formats[i].image_channel_data_type == CL_FLOAT)
-                    ctx->has_float_r_image3d = 1;
+            for (cl_uint i = 0; i < nf && i < 256; ++i) {
+                if (formats[i].image_channel_order != CL_R)
+                    continue;
+                cl_channel_type t = formats[i].image_channel_data_type;
+                ctx->has_float_r_image3d |= t == CL_FLOAT;
+                ctx->has_unorm8_r_image3d |= t == CL_UNORM_INT8;
+                ctx->has_unorm16_r_image3d |= t == CL_UNORM_INT16;
+            }
         }
     }
     umbra_sampler_kind want = desc ? desc->sampler : UMBRA_SAMPLER_AUTO;

@@ -34,6 +34,7 @@ void umbra__frame_update_light(umbra_renderer r)
     }
     F->dims[3] = 0;
     F->bricks[3] = (int32_t)v->brick_size;
+    set4(F->value_map, v->value_map[0], v->value_map[1], v->value_map[2], 0.0f);
     /* The light is given in the volume's world; the kernels work in its local frame. */
     const umbra_light *l = &r->light;
     float lp[3];
@@ -170,11 +171,16 @@ fail:
 
 void umbra__build_options(umbra_renderer r, char *buf, size_t size)
 {
-    int n = snprintf(buf, size, "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u",
-                     r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels);
+    /* The buffer's element type is the volume's: a volume of another type gets another program
+     * (the context caches both). */
+    static const char *const voxel_t[] = {"uchar", "ushort", "short", "float"};
+    umbra_scalar_type t = r->volume ? r->volume->stored_type : UMBRA_FLOAT32;
+    int n = snprintf(buf, size, "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s",
+                     r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
+                     voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32]);
     /* A volume in several slabs: kernels/sampling.cl takes one parameter per slab. One slab adds
      * nothing, so its programs stay those of the single-buffer code. */
-    if (r->volume->slab_count > 1 && n > 0 && (size_t)n < size)
+    if (r->volume && r->volume->slab_count > 1 && n > 0 && (size_t)n < size)
         snprintf(buf + n, size - (size_t)n, " -DUMBRA_VOLUME_SLABS=%u -DUMBRA_SLAB_STEP=%u",
                  r->volume->slab_count, r->volume->slab_step);
 }

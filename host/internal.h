@@ -81,6 +81,7 @@ struct umbra_context_t {
     int profiling;                      /* queue has CL_QUEUE_PROFILING_ENABLE: device times */
     int is_cpu;
     int has_float_r_image3d;
+    int has_unorm8_r_image3d, has_unorm16_r_image3d; /* CL_R 3D images of CL_UNORM_INT8 / 16 */
     umbra_sampler_kind sampler;
     char device_name[600];              /* "platform / device": two 256-byte names */
     umbra__program *programs;           /* cache: one entry per (sources, options) */
@@ -137,12 +138,16 @@ struct umbra_volume_t {
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
     float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
                                 brick-major, x fastest (kernels/umbra_shared.h) */
-    /* The voxels on the device: normalised float32 in buffers (buffer sampler) or CL_R /
-     * CL_FLOAT 3D images (image sampler), in slab_count z-slabs; slab s holds the layers
-     * [s * slab_step, (s + 1) * slab_step] clipped to the grid (host/volume_slabs.c). */
+    /* The voxels on the device, in slab_count z-slabs (slab s holds the layers
+     * [s * slab_step, (s + 1) * slab_step] clipped to the grid, host/volume_slabs.c): buffers of
+     * the input type's raw values, or normalised float32 (stored_type FLOAT32 with value_map
+     * 0, 1, 1), for the buffer sampler; 3D images for the image sampler: CL_R of CL_UNORM_INT8 /
+     * CL_UNORM_INT16 (int16 biased by 32768) or normalised CL_FLOAT. */
     cl_mem slabs[UMBRA__MAX_SLABS];
     uint32_t slab_count;
     uint32_t slab_step;
+    umbra_scalar_type stored_type; /* element type on the device (kernels' UMBRA_VOXEL_T) */
+    float value_map[3];      /* UmbraFrame.value_map: stored value s -> clamp((s [2] - [0]) [1]) */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
     /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
@@ -181,15 +186,24 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
                                int image, const umbra__device_limits *lim, uint32_t *count,
                                uint32_t *step, uint64_t *bytes);
 
-/* Creates v's slabs (v->slab_count, v->slab_step set) from voxels, dims[0] * dims[1] * dims[2]
- * values of voxel_bytes each, x fastest, copied: buffers, or 3D images of format fmt when fmt is
- * not NULL. On failure the slabs made so far stay in v->slabs for umbra_volume_release. */
-umbra_status umbra__slabs_upload(umbra_context ctx, umbra_volume v, const void *voxels,
-                                 size_t voxel_bytes, const cl_image_format *fmt);
+/* Creates v's slabs (sets v->slab_count, slab_step, device_bytes) for voxels of voxel_bytes
+ * each: buffers, or 3D images of format fmt when fmt is not NULL; filled from voxels (dims[0] *
+ * dims[1] * dims[2] values, x fastest, copied) unless it is NULL (the caller then writes each
+ * slab's layers, umbra__slab_layers). On failure the slabs made so far stay in v->slabs for
+ * umbra_volume_release. */
+umbra_status umbra__slabs_create(umbra_context ctx, umbra_volume v, size_t voxel_bytes,
+                                 const cl_image_format *fmt, const void *voxels);
+
+/* The voxel layers [*z0, *z1] (inclusive) that slab s of v holds. */
+void umbra__slab_layers(umbra_volume v, uint32_t s, uint32_t *z0, uint32_t *z1);
 
 /* Reads v's voxels back from its slabs into out (dims[0] * dims[1] * dims[2] values of
  * voxel_bytes each, as the device holds them, x fastest). Blocks. */
 umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes);
+
+/* v's voxels read back and normalised to [0,1] as the kernels normalise them (voxel_normalise in
+ * kernels/sampling.cl): dims[0] * dims[1] * dims[2] floats into out, x fastest. Blocks. */
+umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */

@@ -13,7 +13,7 @@
 #include "internal.h"
 #include "umbra_shared.h"
 
-_Static_assert(sizeof(UmbraFrame) == 13 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
+_Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
 _Static_assert(sizeof(UmbraShadow) == 6 * 16 + 3 * 4 + 8 * 4 + 13 * 4, "UmbraShadow layout");
 
 typedef struct umbra__technique {

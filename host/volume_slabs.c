@@ -97,24 +97,31 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
     return UMBRA_SUCCESS;
 }
 
-umbra_status umbra__slabs_upload(umbra_context ctx, umbra_volume v, const void *voxels,
-                                 size_t voxel_bytes, const cl_image_format *fmt)
+void umbra__slab_layers(umbra_volume v, uint32_t s, uint32_t *z0, uint32_t *z1)
+{
+    *z0 = s * v->slab_step;
+    *z1 = v->slab_count == 1 || *z0 + v->slab_step > v->dims[2] - 1 ? v->dims[2] - 1
+                                                                     : *z0 + v->slab_step;
+}
+
+umbra_status umbra__slabs_create(umbra_context ctx, umbra_volume v, size_t voxel_bytes,
+                                 const cl_image_format *fmt, const void *voxels)
 {
     umbra_status st;
     umbra__device_limits lim;
-    uint32_t count, step;
     uint64_t bytes;
     if ((st = umbra__device_limits_get(ctx, fmt != NULL, &lim)) != UMBRA_SUCCESS ||
-        (st = umbra__slabs_plan(ctx, v->dims, voxel_bytes, fmt != NULL, &lim, &count, &step,
-                                &bytes)) != UMBRA_SUCCESS)
+        (st = umbra__slabs_plan(ctx, v->dims, voxel_bytes, fmt != NULL, &lim, &v->slab_count,
+                                &v->slab_step, &bytes)) != UMBRA_SUCCESS)
         return st;
     const size_t layer = (size_t)v->dims[0] * v->dims[1] * voxel_bytes;
-    for (uint32_t s = 0; s < count; ++s) {
-        const uint32_t z0 = s * step;
-        const uint32_t z1 = count == 1 || z0 + step > v->dims[2] - 1 ? v->dims[2] - 1 : z0 + step;
+    const cl_mem_flags copy = voxels ? CL_MEM_COPY_HOST_PTR : 0;
+    for (uint32_t s = 0; s < v->slab_count; ++s) {
+        uint32_t z0, z1;
+        umbra__slab_layers(v, s, &z0, &z1);
         const size_t depth = (size_t)z1 - z0 + 1;
         /* The host pointer is only read (CL_MEM_COPY_HOST_PTR copies it at the call). */
-        void *src = (char *)(uintptr_t)voxels + (size_t)z0 * layer;
+        void *src = voxels ? (char *)(uintptr_t)voxels + (size_t)z0 * layer : NULL;
         cl_int err;
         if (fmt) {
             cl_image_desc idesc;
@@ -123,17 +130,15 @@ umbra_status umbra__slabs_upload(umbra_context ctx, umbra_volume v, const void *
             idesc.image_width = v->dims[0];
             idesc.image_height = v->dims[1];
             idesc.image_depth = depth;
-            v->slabs[s] = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, fmt,
-                                        &idesc, src, &err);
+            v->slabs[s] = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | copy, fmt, &idesc, src,
+                                        &err);
             UMBRA_CL_CHECK(err, "clCreateImage(volume slab)");
         } else {
-            v->slabs[s] = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                         depth * layer, src, &err);
+            v->slabs[s] = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | copy, depth * layer, src,
+                                         &err);
             UMBRA_CL_CHECK(err, "clCreateBuffer(volume slab)");
         }
     }
-    v->slab_count = count;
-    v->slab_step = step;
     v->device_bytes = (size_t)bytes;
 fail:
     return st;
@@ -145,9 +150,10 @@ umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes)
     umbra_status st = UMBRA_SUCCESS;
     const size_t layer = (size_t)v->dims[0] * v->dims[1] * voxel_bytes;
     for (uint32_t s = 0; s < v->slab_count; ++s) {
-        /* Each slab's first layer; the last slab also its apron-free end. */
-        const uint32_t z0 = s * v->slab_step;
-        const uint32_t z1 = s + 1 == v->slab_count ? v->dims[2] : z0 + v->slab_step;
+        /* Each slab without its last layer (the next slab's first), the last slab whole. */
+        uint32_t z0, z1;
+        umbra__slab_layers(v, s, &z0, &z1);
+        z1 += s + 1 == v->slab_count;
         char *dst = (char *)out + (size_t)z0 * layer;
         cl_mem_object_type type = 0;
         UMBRA_CL(clGetMemObjectInfo(v->slabs[s], CL_MEM_TYPE, sizeof type, &type, NULL));
@@ -162,4 +168,41 @@ umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes)
     }
 fail:
     return st;
+}
+
+umbra_status umbra__volume_read_normalised(umbra_volume v, float *out)
+{
+    const size_t count = (size_t)v->dims[0] * v->dims[1] * v->dims[2];
+    const size_t esize = umbra_scalar_type_size(v->stored_type);
+    /* Float voxels are read in place; narrower ones into the front of out's own bytes would be
+     * overwritten while converting forwards, so they are read into its back end and converted
+     * from the front (element i's source lies at or after where value i is written). */
+    unsigned char *raw = (unsigned char *)out + count * (sizeof *out - esize);
+    umbra_status st = umbra__slabs_read(v, raw, esize);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    for (size_t i = 0; i < count; ++i) {
+        float s;
+        switch (v->stored_type) {
+        case UMBRA_UINT8: s = (float)raw[i]; break;
+        case UMBRA_UINT16: {
+            uint16_t x;
+            memcpy(&x, raw + 2 * i, 2);
+            s = (float)x;
+            break;
+        }
+        case UMBRA_INT16: {
+            int16_t x;
+            memcpy(&x, raw + 2 * i, 2);
+            s = (float)x;
+            break;
+        }
+        default: memcpy(&s, raw + 4 * i, 4); break;
+        }
+        /* As voxel_normalise in kernels/sampling.cl, with an image's UNORM texels read as the
+         * integers they encode (value_map[0] is in those units). */
+        float x = (s - v->value_map[0]) * v->value_map[1];
+        out[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
+    }
+    return UMBRA_SUCCESS;
 }

@@ -19,6 +19,7 @@ typedef struct VolGeom {
     int3 bricks;
     int brick_size;
     int cell_size; /* voxels along a brick's sub-cell: ceil(brick_size / UMBRA_BRICK_CELLS) */
+    float value_lo, value_scale, image_scale; /* UmbraFrame.value_map (kernels/sampling.cl) */
 } VolGeom;
 
 inline VolGeom vol_geom(__global const UmbraFrame *F)
@@ -32,6 +33,9 @@ inline VolGeom vol_geom(__global const UmbraFrame *F)
     g.bricks = (int3)(F->bricks[0], F->bricks[1], F->bricks[2]);
     g.brick_size = F->bricks[3];
     g.cell_size = (g.brick_size + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
+    g.value_lo = F->value_map[0];
+    g.value_scale = F->value_map[1];
+    g.image_scale = F->value_map[2];
     return g;
 }
 

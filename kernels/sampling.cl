@@ -1,13 +1,21 @@
 // SPDX-License-Identifier: Apache-2.0
 /* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
- * build time (UMBRA_SAMPLER_IMAGE): a float buffer with hand-written trilinear interpolation
- * (fastest on PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture
- * hardware on GPUs). Both clamp to the border voxels and put voxel centres at integer voxel
- * coordinates, so they agree to the filtering hardware's precision.
+ * build time (UMBRA_SAMPLER_IMAGE): a buffer with hand-written trilinear interpolation (fastest on
+ * PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture hardware on GPUs).
+ * Both clamp to the border voxels and put voxel centres at integer voxel coordinates, so they
+ * agree to the filtering hardware's precision.
+ *
+ * Voxels stay in the volume's own type on the device (UMBRA_VOXEL_T: uchar, ushort, short or
+ * float, a build option from the volume), 1, 2 or 4 bytes each, and are normalised to [0,1]
+ * through the value range when read: n = clamp((s * image_scale - lo) * scale, 0, 1)
+ * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The buffer path normalises
+ * each of the eight corners before interpolating, exactly as the float volume did, so values
+ * outside a given range clamp before they blend. The image path's filter blends first: the host
+ * stores a normalised float image instead wherever that would differ (host/volume.c).
  *
  * A volume larger than one device allocation (or, for images, deeper than the device's largest
- * 3D image) lives in UMBRA_VOLUME_SLABS z-slabs (host/volume.c): slab s holds the voxel layers
- * [s * UMBRA_SLAB_STEP, (s + 1) * UMBRA_SLAB_STEP], the last one clipped to the grid, so
+ * 3D image) lives in UMBRA_VOLUME_SLABS z-slabs (host/volume_slabs.c): slab s holds the voxel
+ * layers [s * UMBRA_SLAB_STEP, (s + 1) * UMBRA_SLAB_STEP], the last one clipped to the grid, so
  * neighbouring slabs share one layer (the apron). A trilinear sample reads the layers floor(z) and
  * floor(z) + 1, which always lie in the slab floor(z) / UMBRA_SLAB_STEP; the gradient is built
  * from such samples, so neither ever straddles two slabs and a split volume samples exactly as an
@@ -19,6 +27,9 @@
 #ifndef UMBRA_SAMPLER_IMAGE
 #define UMBRA_SAMPLER_IMAGE 0
 #endif
+#ifndef UMBRA_VOXEL_T
+#define UMBRA_VOXEL_T float
+#endif
 #ifndef UMBRA_VOLUME_SLABS
 #define UMBRA_VOLUME_SLABS 1
 #endif
@@ -29,10 +40,16 @@
 #error "a volume in several slabs needs UMBRA_SLAB_STEP (voxel layers from one slab to the next)"
 #endif
 
+/* A stored value (a raw voxel, or a UNORM image's value in [0,1]) mapped to [0,1]. */
+UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
+{
+    return clamp((s * g.image_scale - g.value_lo) * g.value_scale, 0.0f, 1.0f);
+}
+
 #if UMBRA_SAMPLER_IMAGE
 #define UMBRA_SLAB_PARAM(i) __read_only image3d_t vol_##i
 #else
-#define UMBRA_SLAB_PARAM(i) __global const float *restrict vol_##i
+#define UMBRA_SLAB_PARAM(i) __global const UMBRA_VOXEL_T *restrict vol_##i
 #endif
 #define UMBRA_SLAB_NAME(i) vol_##i
 #define UMBRA_SLABS_1(M) M(0)
@@ -50,7 +67,7 @@
 #if UMBRA_SAMPLER_IMAGE
 #define VOLUME_PARAM __read_only image3d_t vol
 #else
-#define VOLUME_PARAM __global const float *restrict vol
+#define VOLUME_PARAM __global const UMBRA_VOXEL_T *restrict vol
 #endif
 #else
 #define VOLUME_PARAM UMBRA_SLABS(UMBRA_VOLUME_SLABS, UMBRA_SLAB_PARAM)
@@ -65,7 +82,7 @@ __constant sampler_t umbra_linear =
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 u = (p - g.box_min) / (g.box_max - g.box_min);
-    return read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x;
+    return voxel_normalise(g, read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x);
 }
 #else
 /* Unnormalised coordinates: voxel i's centre is at i + 0.5 in its slab's image. */
@@ -75,7 +92,7 @@ __constant sampler_t umbra_linear =
 /* Images cannot be held in variables or chosen with ?: in OpenCL C 1.2: one read per case. */
 #define UMBRA_SLAB_READ(i)                                                                     \
     case i:                                                                                    \
-        return read_imagef(vol_##i, umbra_linear, c).x;
+        return voxel_normalise(g, read_imagef(vol_##i, umbra_linear, c).x);
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
@@ -108,6 +125,13 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 }
 #endif
 #else
+/* Voxel i (x fastest) of one buffer (the volume or a slab), normalised. The one place the buffer
+ * is read. */
+UMBRA_INLINE float voxel_load(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t i)
+{
+    return voxel_normalise(g, convert_float(v[i]));
+}
+
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
@@ -116,11 +140,11 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     int3 i0 = convert_int3(fl);
     int3 i1 = min(i0 + 1, g.dims - 1);
 #if UMBRA_VOLUME_SLABS == 1
-    __global const float *restrict v = vol;
+    __global const UMBRA_VOXEL_T *restrict v = vol;
 #else
     /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
     const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
-    __global const float *v = vol_0;
+    __global const UMBRA_VOXEL_T *v = vol_0;
     v = s == 1 ? vol_1 : v;
 #if UMBRA_VOLUME_SLABS > 2
     v = s == 2 ? vol_2 : v;
@@ -146,10 +170,10 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float c000 = v[z0 + y0 + i0.x], c100 = v[z0 + y0 + i1.x];
-    float c010 = v[z0 + y1 + i0.x], c110 = v[z0 + y1 + i1.x];
-    float c001 = v[z1 + y0 + i0.x], c101 = v[z1 + y0 + i1.x];
-    float c011 = v[z1 + y1 + i0.x], c111 = v[z1 + y1 + i1.x];
+    float c000 = voxel_load(v, g, z0 + y0 + i0.x), c100 = voxel_load(v, g, z0 + y0 + i1.x);
+    float c010 = voxel_load(v, g, z0 + y1 + i0.x), c110 = voxel_load(v, g, z0 + y1 + i1.x);
+    float c001 = voxel_load(v, g, z1 + y0 + i0.x), c101 = voxel_load(v, g, z1 + y0 + i1.x);
+    float c011 = voxel_load(v, g, z1 + y1 + i0.x), c111 = voxel_load(v, g, z1 + y1 + i1.x);
     float c00 = mix(c000, c100, f.x), c10 = mix(c010, c110, f.x);
     float c01 = mix(c001, c101, f.x), c11 = mix(c011, c111, f.x);
     return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);

@@ -49,6 +49,8 @@ typedef struct UmbraFrame {
     float background[4];
     float ground_color[4];
     float ground[4];       /* ground plane n.x + d = 0 as (n, d), n unit, facing +y */
+    float value_map[4];    /* stored voxel -> normalised value: clamp((s * [2] - [0]) * [1], 0, 1)
+                              for the sampler's stored value s (kernels/sampling.cl) */
     int32_t dims[4];       /* voxels per axis */
     int32_t bricks[4];     /* bricks per axis; [3] = brick edge in voxels */
     uint32_t width, height;

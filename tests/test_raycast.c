@@ -304,7 +304,7 @@ static float *read_voxels(umbra_context ctx, umbra_volume vol)
     float *v = malloc(n * sizeof *v);
     assert_non_null(v);
     (void)ctx;
-    assert_int_equal(umbra__slabs_read(vol, v, sizeof *v), UMBRA_SUCCESS);
+    assert_int_equal(umbra__volume_read_normalised(vol, v), UMBRA_SUCCESS);
     return v;
 }
 
