@@ -10,8 +10,9 @@
  *  - with the test knob (umbra__context_limit_alloc) a small volume is split into 3 and into 8
  *    slabs; its voxels read back as the unsplit volume's, and every technique's image (shaded,
  *    directional and point light, coloured transmission) equals the unsplit image up to float
- *    rounding (bit for bit on PoCL); the same for the 3D-image sampler where the device has
- *    float 3D images (ray caster and CSSM).
+ *    rounding (bit for bit on PoCL); also for uint8 volumes stored as uint8; the same for the
+ *    3D-image sampler where the device has float 3D images (ray caster and CSSM; uint8 as
+ *    CL_UNORM_INT8 slabs).
  * Usage: test_slabs [filter] (a cmocka test-name glob). */
 #include <math.h>
 #include <stdio.h>
@@ -44,14 +45,47 @@ static float *scene_voxels(void)
     return v;
 }
 
+/* The scene as float32, or quantised to uint8 (range 0..255): stored natively on the device. */
+static umbra_volume scene_volume_typed(umbra_context ctx, const float *voxels,
+                                       umbra_scalar_type type, uint64_t alloc_limit,
+                                       uint32_t want_slabs)
+{
+    const size_t n = (size_t)NX * NY * NZ;
+    uint8_t *bytes = NULL;
+    umbra_volume_desc d;
+    umbra_volume_desc_init(&d);
+    d.type = type;
+    d.dims[0] = NX;
+    d.dims[1] = NY;
+    d.dims[2] = NZ;
+    d.brick_size = 8;
+    d.value_range_given = 1;
+    d.value_min = 0.0f;
+    d.value_max = type == UMBRA_UINT8 ? 255.0f : 1.0f;
+    d.data = voxels;
+    if (type == UMBRA_UINT8) {
+        bytes = malloc(n);
+        assert_non_null(bytes);
+        for (size_t i = 0; i < n; ++i)
+            bytes[i] = (uint8_t)lrintf(voxels[i] * 255.0f);
+        d.data = bytes;
+    }
+    umbra_volume v = NULL;
+    umbra__context_limit_alloc(ctx, alloc_limit);
+    umbra_status st = umbra_volume_create(ctx, &d, &v);
+    umbra__context_limit_alloc(ctx, 0);
+    free(bytes);
+    if (st != UMBRA_SUCCESS)
+        fail_msg("umbra_volume_create: %s", umbra_context_last_message(ctx));
+    assert_int_equal(v->stored_type, type);
+    assert_int_equal(v->slab_count, want_slabs);
+    return v;
+}
+
 static umbra_volume scene_volume(umbra_context ctx, const float *voxels, uint64_t alloc_limit,
                                  uint32_t want_slabs)
 {
-    umbra__context_limit_alloc(ctx, alloc_limit);
-    umbra_volume v = test_volume_bricks(ctx, NX, NY, NZ, voxels, 8);
-    umbra__context_limit_alloc(ctx, 0);
-    assert_int_equal(v->slab_count, want_slabs);
-    return v;
+    return scene_volume_typed(ctx, voxels, UMBRA_FLOAT32, alloc_limit, want_slabs);
 }
 
 static umbra_transfer_function scene_tf(umbra_context ctx)
@@ -226,6 +260,16 @@ static void test_split_voxels_read_back_unchanged(void **state)
     free(b);
     umbra_volume_release(whole);
     umbra_volume_release(split);
+    whole = scene_volume_typed(ctx, voxels, UMBRA_UINT8, 0, 1);
+    split = scene_volume_typed(ctx, voxels, UMBRA_UINT8, 7 * LAYER / 4, 8);
+    assert_int_equal(split->device_bytes, (NZ + 7) * LAYER / 4);
+    a = test_read_voxels(whole);
+    b = test_read_voxels(split);
+    assert_memory_equal(a, b, (size_t)NX * NY * NZ * sizeof *a);
+    free(a);
+    free(b);
+    umbra_volume_release(whole);
+    umbra_volume_release(split);
     free(voxels);
 }
 
@@ -252,12 +296,14 @@ static const technique_case cases[] = {
 /* The cases[] in mask (bit c for cases[c]) with the volume unsplit and split into `slabs` slabs
  * (the allocation limit fit_layers * LAYER); tol bounds |split - unsplit|. Each case compiles its
  * programs twice (unsplit, split), so the lists are kept short. */
-static void compare_techniques(umbra_context ctx, unsigned mask, uint64_t fit_layers,
-                               uint32_t slabs, double tol)
+static void compare_techniques(umbra_context ctx, umbra_scalar_type type, unsigned mask,
+                               uint64_t fit_layers, uint32_t slabs, double tol)
 {
     float *voxels = scene_voxels();
-    umbra_volume vols[2] = {scene_volume(ctx, voxels, 0, 1),
-                            scene_volume(ctx, voxels, fit_layers * LAYER, slabs)};
+    /* The limit counts float32 layers; a uint8 layer is a quarter of one. */
+    const uint64_t limit = fit_layers * LAYER / (type == UMBRA_UINT8 ? 4 : 1);
+    umbra_volume vols[2] = {scene_volume_typed(ctx, voxels, type, 0, 1),
+                            scene_volume_typed(ctx, voxels, type, limit, slabs)};
     umbra_transfer_function tf = scene_tf(ctx);
     const size_t n = (size_t)W * H * 4;
     float *img[2];
@@ -282,8 +328,8 @@ static void compare_techniques(umbra_context ctx, unsigned mask, uint64_t fit_la
         for (int i = 0; i < 2; ++i)
             render(ctx, vols[i], tf, &sd, &light, cases[c].colored, img[i]);
         double peak, d = max_diff(img[0], img[1], n, &peak);
-        print_message("  %-24s %u slabs: max |split - unsplit| %.2e (image peak %.2f)\n",
-                      cases[c].name, slabs, d, peak);
+        print_message("  %-24s %-7s %u slabs: max |split - unsplit| %.2e (image peak %.2f)\n",
+                      cases[c].name, type == UMBRA_UINT8 ? "uint8" : "float32", slabs, d, peak);
         if (!(peak > 0.05))
             fail_msg("%s: the image is empty (peak %g): nothing compared", cases[c].name, peak);
         if (!(d <= tol))
@@ -304,8 +350,10 @@ static void test_split_images_match_unsplit_buffer_sampler(void **state)
     /* Every technique in 3 slabs (with the buffer sampler a split volume samples bit for bit as
      * a whole one; the bound leaves room for a compiler's different contraction), the most
      * slabs with the ray caster alone. */
-    compare_techniques(ctx, ~0u, 20, 3, 1e-6);
-    compare_techniques(ctx, 1u << 0, 7, 8, 1e-6);
+    compare_techniques(ctx, UMBRA_FLOAT32, ~0u, 20, 3, 1e-6);
+    compare_techniques(ctx, UMBRA_FLOAT32, 1u << 0, 7, 8, 1e-6);
+    /* Stored as uint8 on the device (the 6 GiB scans this is for). */
+    compare_techniques(ctx, UMBRA_UINT8, (1u << 0) | (1u << 4), 20, 3, 1e-6);
 }
 
 static void test_split_images_match_unsplit_image_sampler(void **state)
@@ -325,7 +373,9 @@ static void test_split_images_match_unsplit_image_sampler(void **state)
     }
     /* The split images address their slabs with unnormalised coordinates, the whole image with
      * normalised ones: the filter's weights differ by rounding. */
-    compare_techniques(ctx, (1u << 0) | (1u << 4), 20, 3, 1e-4);
+    compare_techniques(ctx, UMBRA_FLOAT32, (1u << 0) | (1u << 4), 20, 3, 1e-4);
+    /* uint8 as CL_UNORM_INT8 slabs (copied as given; float32 goes through the staged upload). */
+    compare_techniques(ctx, UMBRA_UINT8, 1u << 0, 20, 3, 1e-4);
     umbra_context_release(ctx);
 }
 
