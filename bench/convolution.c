@@ -146,10 +146,7 @@ static umbra_volume load_carp(umbra_context ctx, const char *path, int k, char *
     uint32_t m[3] = {n[0] / k, n[1] / k, n[2] / k};
     v = malloc(count * sizeof *v);
     d = malloc((size_t)m[0] * m[1] * m[2] * sizeof *d);
-    umbra_status err = UMBRA_ERROR_OUT_OF_MEMORY;
-    if (v && d)
-        err = umbra__volume_read_normalised(full, v);
-    if (err != UMBRA_SUCCESS) {
+    if (!v || !d || umbra__volume_read_normalised(full, v) != UMBRA_SUCCESS) {
         fprintf(stderr, "umbra-bench: reading %s back failed\n", path);
         goto done;
     }

@@ -175,9 +175,12 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
      * (the context caches both). */
     static const char *const voxel_t[] = {"uchar", "ushort", "short", "float"};
     umbra_scalar_type t = r->volume ? r->volume->stored_type : UMBRA_FLOAT32;
-    int n = snprintf(buf, size, "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s",
+    int n = snprintf(buf, size,
+                     "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s "
+                     "-DUMBRA_VOXEL_CLAMPS=%d",
                      r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
-                     voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32]);
+                     voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
+                     r->volume ? r->volume->clamps : 1);
     /* A volume in several slabs: kernels/sampling.cl takes one parameter per slab. One slab adds
      * nothing, so its programs stay those of the single-buffer code. */
     if (r->volume && r->volume->slab_count > 1 && n > 0 && (size_t)n < size)

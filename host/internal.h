@@ -148,6 +148,7 @@ struct umbra_volume_t {
     uint32_t slab_step;
     umbra_scalar_type stored_type; /* element type on the device (kernels' UMBRA_VOXEL_T) */
     float value_map[3];      /* UmbraFrame.value_map: stored value s -> clamp((s [2] - [0]) [1]) */
+    int clamps;              /* some stored value maps outside [0,1] (kernels' UMBRA_VOXEL_CLAMPS) */
     uint64_t id;             /* unique per volume, for cache invalidation */
     size_t device_bytes;
     /* Index-to-world transform. The kernels work in the local frame (the centred, axis-aligned
@@ -178,7 +179,8 @@ void umbra__context_limit_alloc(umbra_context ctx, uint64_t bytes);
 
 /* Splits dims (voxel_bytes per voxel) into the fewest z-slabs that each fit lim (one slab when
  * the whole volume fits): *count slabs, slab s starting at layer s * *step (the step is dims[2]
- * for one slab), *bytes on the device in all, aprons included. UMBRA_ERROR_OUT_OF_MEMORY with a
+ * for one slab), *bytes on the device in all, aprons and buffers' pad elements
+ * included. UMBRA_ERROR_OUT_OF_MEMORY with a
  * message naming the sizes when the slabs would exceed the device's global memory, two layers
  * exceed one allocation, or more than UMBRA__MAX_SLABS slabs would be needed;
  * UMBRA_ERROR_UNSUPPORTED when a layer is wider or taller than the device's largest 3D image. */

@@ -272,14 +272,25 @@ static void convert_voxels(const void *src, umbra_scalar_type type, size_t first
  * host/volume_slabs.c) from the caller's voxels: straight from them where the device stores the
  * input as it is, else through a bounded staging buffer (a few MiB), never a converted copy of
  * the whole volume. Blocks until the data is on the device. */
-static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, stored_form form,
-                           double lo, double scale)
+static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, cl_mem filled,
+                           stored_form form, double lo, double scale)
 {
     umbra_context ctx = v->ctx;
     umbra_status st = UMBRA_SUCCESS;
     const size_t nx = v->dims[0], ny = v->dims[1];
     const size_t esize = umbra_scalar_type_size(v->stored_type);
     void *stage = NULL;
+    if (filled && form == STORED_RAW) {
+        /* desc->data is filled's mapping: the buffer already holds the voxels as stored (and
+         * umbra_volume_create_filled maps one only for a volume that fits one buffer). */
+        clRetainMemObject(filled);
+        v->slabs[0] = filled;
+        v->slab_count = 1;
+        v->slab_step = v->dims[2];
+        /* The buffer has one pad element (host/volume_slabs.c). */
+        v->device_bytes = ((size_t)v->dims[0] * v->dims[1] * v->dims[2] + 1) * esize;
+        return UMBRA_SUCCESS;
+    }
     const cl_image_format fmt = {CL_R, v->stored_type == UMBRA_UINT8    ? CL_UNORM_INT8
                                        : v->stored_type == UMBRA_UINT16 ? CL_UNORM_INT16
                                                                         : CL_FLOAT};
@@ -321,7 +332,8 @@ fail:
     return st;
 }
 
-static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *desc,
+/* filled: NULL, or a buffer sampler's buffer (of desc->type) whose mapping desc->data is. */
+static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *desc, cl_mem filled,
                                   umbra_volume *out)
 {
     umbra_status st = validate(ctx, desc);
@@ -491,6 +503,7 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
             form = STORED_NORMALISED;
     } else if (desc->type == UMBRA_FLOAT32 && !float_ok)
         form = STORED_NORMALISED;
+    v->clamps = form != STORED_NORMALISED && clamps;
     if (form == STORED_NORMALISED) {
         v->stored_type = UMBRA_FLOAT32;
         v->value_map[0] = 0.0f;
@@ -519,7 +532,7 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
             tables[t][i] = x;
         }
 
-    if ((st = upload(v, desc, form, lo, scale)) != UMBRA_SUCCESS)
+    if ((st = upload(v, desc, filled, form, lo, scale)) != UMBRA_SUCCESS)
         goto fail;
     free(intervals);
     *out = v;
@@ -544,7 +557,93 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_volume_create: ctx %p, desc %p: neither may be NULL",
                            (void *)ctx, (void *)desc);
-    return volume_create(ctx, desc, out);
+    return volume_create(ctx, desc, NULL, out);
+}
+
+umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_desc *desc,
+                                        umbra_volume_fill_fn fill, void *user, umbra_volume *out)
+{
+    const char *fn = "umbra_volume_create_filled";
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", fn);
+    *out = NULL;
+    if (!ctx || !desc || !fill)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: ctx %p, desc %p, fill %p: none may be NULL", fn, (void *)ctx,
+                           (void *)desc, (void *)(uintptr_t)fill);
+    if (desc->struct_size == sizeof *desc && desc->data)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: desc->data must be NULL: fill writes the voxels", fn);
+    /* validate() wants data: a stand-in until the real pointer is known. */
+    umbra_volume_desc d = *desc;
+    d.data = &d;
+    umbra_status st = validate(ctx, &d);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    const size_t bytes = (size_t)d.dims[0] * d.dims[1] * d.dims[2] * umbra_scalar_type_size(d.type);
+    cl_mem buf = NULL;
+    void *host = NULL, *mapped = NULL;
+    cl_int err;
+    /* One mapped buffer only for a volume that fits one (host/volume_slabs.c); the slabs of a
+     * larger one are filled from host memory, as an image is. */
+    umbra__device_limits lim;
+    uint32_t nslabs = 1, step;
+    uint64_t need;
+    if ((st = umbra__device_limits_get(ctx, ctx->sampler == UMBRA_SAMPLER_IMAGE, &lim)) !=
+            UMBRA_SUCCESS ||
+        (st = umbra__slabs_plan(ctx, d.dims, umbra_scalar_type_size(d.type),
+                                ctx->sampler == UMBRA_SAMPLER_IMAGE, &lim, &nslabs, &step,
+                                &need)) != UMBRA_SUCCESS)
+        return st;
+    if (ctx->sampler == UMBRA_SAMPLER_BUFFER && nslabs == 1) {
+        /* The device's own buffer, mapped: on a CPU device the mapping is the buffer itself,
+         * so the voxels are written once, where the kernels read them. */
+        buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR,
+                             bytes + umbra_scalar_type_size(d.type), NULL, &err);
+        if (err == CL_SUCCESS)
+            mapped = clEnqueueMapBuffer(ctx->queue, buf, CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION,
+                                        0, bytes + umbra_scalar_type_size(d.type), 0, NULL, NULL,
+                                        &err);
+        if (err == CL_SUCCESS) /* the sampler's pad element (see upload) */
+            memset((unsigned char *)mapped + bytes, 0, umbra_scalar_type_size(d.type));
+        if (err != CL_SUCCESS) {
+            int oom = err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
+                      err == CL_OUT_OF_HOST_MEMORY;
+            st = umbra__fail(ctx, oom ? UMBRA_ERROR_OUT_OF_MEMORY : UMBRA_ERROR_OPENCL,
+                             "%s: a mapped buffer of %zu bytes for %u x %u x %u voxels: %s (%d)",
+                             fn, bytes, d.dims[0], d.dims[1], d.dims[2], umbra__cl_error_name(err),
+                             (int)err);
+            goto fail;
+        }
+        d.data = mapped;
+    } else {
+        /* An image (or slabs) is made from host memory: the voxels go there first. */
+        host = malloc(bytes);
+        if (!host) {
+            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "%s: out of host memory for %zu bytes of voxels", fn, bytes);
+            goto fail;
+        }
+        d.data = host;
+    }
+    if ((st = fill(user, (void *)d.data, bytes)) != UMBRA_SUCCESS)
+        goto fail;
+    st = volume_create(ctx, &d, buf, out);
+fail:
+    if (mapped) {
+        /* The kernels that will read the buffer are queued after the unmap. */
+        err = clEnqueueUnmapMemObject(ctx->queue, buf, mapped, 0, NULL, NULL);
+        if (err != CL_SUCCESS && st == UMBRA_SUCCESS) {
+            umbra_volume_release(*out);
+            *out = NULL;
+            st = umbra__fail(ctx, UMBRA_ERROR_OPENCL, "%s: clEnqueueUnmapMemObject: %s (%d)", fn,
+                             umbra__cl_error_name(err), (int)err);
+        }
+    }
+    if (buf)
+        clReleaseMemObject(buf);
+    free(host);
+    return st;
 }
 
 umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)

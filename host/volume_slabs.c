@@ -7,7 +7,10 @@
  * one layer (the apron), so every trilinear sample, and every central-difference gradient built
  * from such samples, reads one slab only (kernels/sampling.cl picks it by the sample's z). The
  * plan is made, and checked against the device's global memory, before anything is allocated, so
- * a volume that cannot fit is refused with its sizes instead of failing half-way through. */
+ * a volume that cannot fit is refused with its sizes instead of failing half-way through.
+ *
+ * Every buffer has one pad element after its last voxel: the buffer sampler reads voxels in x
+ * pairs (vload2), and the pair of a slab's last voxel reads one beyond it, with weight 0. */
 #include <string.h>
 
 #include "internal.h"
@@ -51,6 +54,7 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
     const char *what = image ? "3D image" : "buffer";
     const uint64_t layer = (uint64_t)dims[0] * dims[1] * voxel_bytes;
     const uint64_t total = layer * dims[2];
+    const uint64_t pad = image ? 0 : voxel_bytes;
     if (image && (dims[0] > lim->image_max[0] || dims[1] > lim->image_max[1]))
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: dims %u x %u x %u: the device's largest 3D image is %zu x %zu "
@@ -58,7 +62,7 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
                            "such limit)", fn, dims[0], dims[1], dims[2], lim->image_max[0],
                            lim->image_max[1], lim->image_max[2]);
     /* The most layers one slab may hold. */
-    uint64_t fit = lim->max_alloc / layer;
+    uint64_t fit = lim->max_alloc > pad ? (lim->max_alloc - pad) / layer : 0;
     if (image && fit > lim->image_max[2])
         fit = lim->image_max[2];
     uint32_t n = 1, s = dims[2];
@@ -69,7 +73,7 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
                                "%s: dims %u x %u x %u: two z-layers (%llu bytes) exceed the "
                                "device's largest %s (%llu bytes)", fn, dims[0], dims[1],
-                               dims[2], (unsigned long long)(2 * layer), what,
+                               dims[2], (unsigned long long)(2 * layer + pad), what,
                                (unsigned long long)lim->max_alloc);
         const uint64_t cells = dims[2] - 1u;
         uint64_t want = (cells + fit - 2) / (fit - 1);
@@ -84,7 +88,7 @@ umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t
         s = (uint32_t)((cells + want - 1) / want);
         n = (uint32_t)((cells + s - 1) / s); /* so that the last slab is not empty */
     }
-    const uint64_t need = n == 1 ? total : total + (uint64_t)(n - 1) * layer;
+    const uint64_t need = total + (uint64_t)(n - 1) * layer + n * pad;
     if (need > lim->global_mem)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
                            "%s: dims %u x %u x %u need %llu bytes of device memory (%u slab%s "
@@ -115,7 +119,6 @@ umbra_status umbra__slabs_create(umbra_context ctx, umbra_volume v, size_t voxel
                                 &v->slab_step, &bytes)) != UMBRA_SUCCESS)
         return st;
     const size_t layer = (size_t)v->dims[0] * v->dims[1] * voxel_bytes;
-    const cl_mem_flags copy = voxels ? CL_MEM_COPY_HOST_PTR : 0;
     for (uint32_t s = 0; s < v->slab_count; ++s) {
         uint32_t z0, z1;
         umbra__slab_layers(v, s, &z0, &z1);
@@ -130,13 +133,20 @@ umbra_status umbra__slabs_create(umbra_context ctx, umbra_volume v, size_t voxel
             idesc.image_width = v->dims[0];
             idesc.image_height = v->dims[1];
             idesc.image_depth = depth;
-            v->slabs[s] = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | copy, fmt, &idesc, src,
-                                        &err);
+            v->slabs[s] = clCreateImage(ctx->cl_ctx,
+                                        CL_MEM_READ_ONLY | (src ? CL_MEM_COPY_HOST_PTR : 0), fmt,
+                                        &idesc, src, &err);
             UMBRA_CL_CHECK(err, "clCreateImage(volume slab)");
         } else {
-            v->slabs[s] = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | copy, depth * layer, src,
-                                         &err);
+            v->slabs[s] = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY,
+                                         (depth * layer) + voxel_bytes, NULL, &err);
             UMBRA_CL_CHECK(err, "clCreateBuffer(volume slab)");
+            const float zero = 0.0f; /* a finite pad: weight 0 times anything else could be NaN */
+            UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->slabs[s], CL_TRUE, depth * layer,
+                                          voxel_bytes, &zero, 0, NULL, NULL));
+            if (src)
+                UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->slabs[s], CL_TRUE, 0, depth * layer,
+                                              src, 0, NULL, NULL));
         }
     }
     v->device_bytes = (size_t)bytes;

@@ -291,14 +291,32 @@ umbra_status umbra__volume_from_host(umbra_context ctx, const void *data, umbra_
     return umbra_volume_create(ctx, &vd, out);
 }
 
+/* What the raw reader's fill callback reads: the rest of f (path), byte-swapped if need be. */
+typedef struct raw_fill {
+    umbra_context ctx;
+    const char *func, *path;
+    FILE *f;
+    size_t count, type_size;
+    int swap;
+} raw_fill;
+
+static umbra_status fill_raw(void *user, void *dst, size_t bytes)
+{
+    raw_fill *r = user;
+    umbra_status st = umbra__file_read(r->ctx, r->func, r->path, r->f, dst, bytes);
+    if (st == UMBRA_SUCCESS && r->swap)
+        umbra__swap_bytes(dst, r->count, r->type_size);
+    return st;
+}
+
 /* The raw reader behind umbra_volume_load_raw and umbra_volume_load_dat; func names the public
- * function in messages. */
+ * function in messages. The file is read straight into the device's buffer
+ * (umbra_volume_create_filled): no host copy of the voxels. */
 static umbra_status load_raw(umbra_context ctx, const char *func, const char *path,
                              const umbra_raw_desc *desc, umbra_volume *out)
 {
     umbra_status st = UMBRA_SUCCESS;
     FILE *f = NULL;
-    void *voxels = NULL;
     size_t file_size = 0, type_size, count, data_bytes, expected;
     int i;
 
@@ -356,27 +374,16 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
                          func, desc->header_bytes, path, umbra__errno_text(errno, buf, sizeof buf));
         goto fail;
     }
-    voxels = malloc(data_bytes);
-    if (!voxels) {
-        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                         "%s: cannot allocate %zu bytes for the voxels of \"%s\"", func,
-                         data_bytes, path);
-        goto fail;
-    }
-    st = umbra__file_read(ctx, func, path, f, voxels, data_bytes);
-    if (st != UMBRA_SUCCESS) {
-        goto fail;
-    }
-    fclose(f);
-    f = NULL;
-    if (type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()) {
-        umbra__swap_bytes(voxels, count, type_size);
-    }
-    st = umbra__volume_from_host(ctx, voxels, desc->type, desc->dims, desc->spacing, NULL, NULL,
-                                 out);
+    raw_fill rf = {ctx, func, path, f, count, type_size,
+                   type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()};
+    umbra_volume_desc vd;
+    umbra_volume_desc_init(&vd);
+    vd.type = desc->type;
+    memcpy(vd.dims, desc->dims, sizeof vd.dims);
+    memcpy(vd.spacing, desc->spacing, sizeof vd.spacing);
+    st = umbra_volume_create_filled(ctx, &vd, fill_raw, &rf, out);
 
 fail:
-    free(voxels);
     if (f) {
         fclose(f);
     }

@@ -8,10 +8,14 @@
  * Voxels stay in the volume's own type on the device (UMBRA_VOXEL_T: uchar, ushort, short or
  * float, a build option from the volume), 1, 2 or 4 bytes each, and are normalised to [0,1]
  * through the value range when read: n = clamp((s * image_scale - lo) * scale, 0, 1)
- * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The buffer path normalises
- * each of the eight corners before interpolating, exactly as the float volume did, so values
- * outside a given range clamp before they blend. The image path's filter blends first: the host
- * stores a normalised float image instead wherever that would differ (host/volume.c).
+ * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The mapping is linear
+ * until it clamps, so where no voxel lies outside the value range (UMBRA_VOXEL_CLAMPS 0, a build
+ * option from the volume) the sampler blends the stored values and maps the result once, which
+ * keeps the buffer path as fast as the float volume was (per-corner mapping cost 20% of a
+ * frame); where a given range clamps voxels, the buffer path maps each of the eight corners
+ * before blending, so values outside the range clamp before they blend, as the float volume
+ * did. The image path's filter always blends first: the host stores a normalised float image
+ * instead wherever that would differ (host/volume.c).
  *
  * A volume larger than one device allocation (or, for images, deeper than the device's largest
  * 3D image) lives in UMBRA_VOLUME_SLABS z-slabs (host/volume_slabs.c): slab s holds the voxel
@@ -29,6 +33,9 @@
 #endif
 #ifndef UMBRA_VOXEL_T
 #define UMBRA_VOXEL_T float
+#endif
+#ifndef UMBRA_VOXEL_CLAMPS
+#define UMBRA_VOXEL_CLAMPS 1
 #endif
 #ifndef UMBRA_VOLUME_SLABS
 #define UMBRA_VOLUME_SLABS 1
@@ -125,11 +132,38 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 }
 #endif
 #else
-/* Voxel i (x fastest) of one buffer (the volume or a slab), normalised. The one place the buffer
- * is read. */
+/* Voxel i (x fastest) of one buffer (the volume or a slab), ready to blend: normalised where
+ * the range clamps, else as stored (voxel_blended maps the blend). The one place the buffer is
+ * read. */
 UMBRA_INLINE float voxel_load(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t i)
 {
+#if UMBRA_VOXEL_CLAMPS
     return voxel_normalise(g, convert_float(v[i]));
+#else
+    return convert_float(v[i]);
+#endif
+}
+
+/* Voxels i and i + 1 (every buffer has a pad element after its last voxel, host/
+ * volume_slabs.c). */
+UMBRA_INLINE float2 voxel_load2(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t i)
+{
+#if UMBRA_VOXEL_CLAMPS
+    float2 s = convert_float2(vload2(0, v + i));
+    return (float2)(voxel_normalise(g, s.x), voxel_normalise(g, s.y));
+#else
+    return convert_float2(vload2(0, v + i));
+#endif
+}
+
+/* A blend of voxel_load values, normalised. */
+UMBRA_INLINE float voxel_blended(VolGeom g, float b)
+{
+#if UMBRA_VOXEL_CLAMPS
+    return b;
+#else
+    return voxel_normalise(g, b);
+#endif
 }
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
@@ -170,13 +204,11 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float c000 = voxel_load(v, g, z0 + y0 + i0.x), c100 = voxel_load(v, g, z0 + y0 + i1.x);
-    float c010 = voxel_load(v, g, z0 + y1 + i0.x), c110 = voxel_load(v, g, z0 + y1 + i1.x);
-    float c001 = voxel_load(v, g, z1 + y0 + i0.x), c101 = voxel_load(v, g, z1 + y0 + i1.x);
-    float c011 = voxel_load(v, g, z1 + y1 + i0.x), c111 = voxel_load(v, g, z1 + y1 + i1.x);
-    float c00 = mix(c000, c100, f.x), c10 = mix(c010, c110, f.x);
-    float c01 = mix(c001, c101, f.x), c11 = mix(c011, c111, f.x);
-    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+    float2 c0 = voxel_load2(v, g, z0 + y0 + i0.x), c1 = voxel_load2(v, g, z0 + y1 + i0.x);
+    float2 c2 = voxel_load2(v, g, z1 + y0 + i0.x), c3 = voxel_load2(v, g, z1 + y1 + i0.x);
+    float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
+    float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
+    return voxel_blended(g, mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z));
 }
 #endif
 

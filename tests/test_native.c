@@ -13,7 +13,9 @@
  *  - the device holds 1 byte per uint8 voxel, 2 per uint16/int16 (the image sampler too, where
  *    the device has UNORM 3D images), 4 per float;
  *  - the value range and every brick's and sub-cell's min/max equal a brute-force scan of the
- *    voxels read back from the device, for brick edges that are and are not multiples of 4. */
+ *    voxels read back from the device, for brick edges that are and are not multiples of 4;
+ *  - umbra_volume_create_filled gives the volume umbra_volume_create gives for the same voxels
+ *    (both samplers), returns the fill's failure as is and refuses desc->data. */
 #include "internal.h" /* the volume's tables and storage */
 #include "test_util.h"
 #include "umbra_shared.h"
@@ -308,6 +310,73 @@ static void test_brick_and_cell_ranges_match_a_scan(void **state)
     free(norm);
 }
 
+typedef struct fill_src {
+    const void *data;
+    size_t bytes;
+    int fail;
+    umbra_context ctx;
+} fill_src;
+
+static umbra_status fill_copy(void *user, void *dst, size_t bytes)
+{
+    fill_src *f = user;
+    if (f->fail)
+        return umbra_context_record_error(f->ctx, UMBRA_ERROR_IO, "fill_copy: the source failed");
+    assert_int_equal(bytes, f->bytes);
+    memcpy(dst, f->data, bytes);
+    return UMBRA_SUCCESS;
+}
+
+static void test_filled_volume_equals_created_volume(void **state)
+{
+    umbra_context ctxs[2] = {*state, image_context()};
+    float *norm = malloc(N * sizeof *norm);
+    assert_non_null(norm);
+    for (int c = 0; c < 2; ++c) {
+        if (!ctxs[c])
+            continue;
+        for (size_t k = 0; k < sizeof TYPES / sizeof TYPES[0]; ++k) {
+            void *raw = make_raw(&TYPES[k], TYPES[k].lo, TYPES[k].hi, norm);
+            umbra_volume a = make_volume(ctxs[c], raw, TYPES[k].type, 0, 0, 0, 0), b = NULL;
+            umbra_volume_desc d;
+            umbra_volume_desc_init(&d);
+            d.type = TYPES[k].type;
+            d.dims[0] = NX;
+            d.dims[1] = NY;
+            d.dims[2] = NZ;
+            fill_src src = {raw, N * umbra_scalar_type_size(d.type), 0, ctxs[c]};
+            assert_int_equal(umbra_volume_create_filled(ctxs[c], &d, fill_copy, &src, &b),
+                             UMBRA_SUCCESS);
+            umbra_volume_info ia, ib;
+            assert_int_equal(umbra_volume_get_info(a, &ia), UMBRA_SUCCESS);
+            assert_int_equal(umbra_volume_get_info(b, &ib), UMBRA_SUCCESS);
+            assert_true(ia.value_min == ib.value_min && ia.value_max == ib.value_max);
+            assert_int_equal(ia.device_bytes, ib.device_bytes);
+            float *va = test_read_voxels(a), *vb = test_read_voxels(b);
+            assert_memory_equal(va, vb, N * sizeof *va);
+            size_t nb = (size_t)a->brick_counts[0] * a->brick_counts[1] * a->brick_counts[2];
+            assert_memory_equal(a->cell_minmax, b->cell_minmax, 2 * 64 * nb * sizeof(float));
+            assert_memory_equal(a->brick_minmax, b->brick_minmax, 2 * nb * sizeof(float));
+            free(va);
+            free(vb);
+            umbra_volume_release(a);
+            umbra_volume_release(b);
+
+            /* The fill's failure comes back as it recorded it; the context still works. */
+            src.fail = 1;
+            test_assert_failed(ctxs[c], umbra_volume_create_filled(ctxs[c], &d, fill_copy, &src, &b),
+                               UMBRA_ERROR_IO, "the source failed", NULL);
+            assert_null(b);
+            d.data = raw;
+            test_assert_failed(ctxs[c], umbra_volume_create_filled(ctxs[c], &d, fill_copy, &src, &b),
+                               UMBRA_ERROR_INVALID_ARGUMENT, "desc->data must be NULL", NULL);
+            free(raw);
+        }
+    }
+    free(norm);
+    umbra_context_release(ctxs[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -315,6 +384,7 @@ int main(void)
         cmocka_unit_test(test_given_range_clamps_before_blending),
         cmocka_unit_test(test_device_bytes_are_the_input_type),
         cmocka_unit_test(test_brick_and_cell_ranges_match_a_scan),
+        cmocka_unit_test(test_filled_volume_equals_created_volume),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -297,15 +297,11 @@ static void test_reference_extreme_opacity_long_path(void **state)
 
 /* ---- the ray caster against the plain-C twin ------------------------------------------------------ */
 
-/* Normalised voxels of vol, read back from the device buffer. */
+/* Normalised voxels of vol, read back from the device. */
 static float *read_voxels(umbra_context ctx, umbra_volume vol)
 {
-    size_t n = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
-    float *v = malloc(n * sizeof *v);
-    assert_non_null(v);
     (void)ctx;
-    assert_int_equal(umbra__volume_read_normalised(vol, v), UMBRA_SUCCESS);
-    return v;
+    return test_read_voxels(vol);
 }
 
 static void fill_cpu_scene(cpu_scene *cs, umbra_volume vol, const float *voxels,

@@ -8,7 +8,8 @@
  *    more than UMBRA__MAX_SLABS slabs, a layer wider than the largest 3D image; the context stays
  *    usable;
  *  - with the test knob (umbra__context_limit_alloc) a small volume is split into 3 and into 8
- *    slabs; its voxels read back as the unsplit volume's, and every technique's image (shaded,
+ *    slabs; its voxels read back as the unsplit volume's (also through
+ *    umbra_volume_create_filled), and every technique's image (shaded,
  *    directional and point light, coloured transmission) equals the unsplit image up to float
  *    rounding (bit for bit on PoCL); also for uint8 volumes stored as uint8; the same for the
  *    3D-image sampler where the device has float 3D images (ray caster and CSSM; uint8 as
@@ -137,9 +138,10 @@ static void test_slab_plan_covers_every_footprint(void **state)
     lim.global_mem = (uint64_t)1 << 40;
     for (uint32_t nz = 1; nz <= 90; ++nz)
         for (uint64_t fit = 1; fit <= 95; ++fit) {
-            /* One byte per layer: the allocation limit counts layers. */
+            /* One byte per layer: the allocation limit counts layers, plus the buffer's pad
+             * element. */
             const uint32_t dims[3] = {1, 1, nz};
-            lim.max_alloc = fit;
+            lim.max_alloc = fit + 1;
             uint32_t count = 0, step = 0;
             uint64_t bytes = 0;
             umbra_status st = umbra__slabs_plan(ctx, dims, 1, 0, &lim, &count, &step, &bytes);
@@ -161,7 +163,7 @@ static void test_slab_plan_covers_every_footprint(void **state)
                     fail_msg("nz %u, fit %u: slab %u holds [%u, %u]", nz, (unsigned)fit, s, z0, z1);
                 sum += z1 - z0 + 1;
             }
-            assert_int_equal(sum, bytes);
+            assert_int_equal(sum + count, bytes);
             /* The kernels' pick (kernels/sampling.cl) for each footprint's first layer. */
             for (uint32_t z = 0; z < nz; ++z) {
                 uint32_t s = count == 1 ? 0 : z / step;
@@ -190,19 +192,19 @@ static void test_slab_plan_refusals_name_the_sizes(void **state)
                      UMBRA_SUCCESS);
     assert_int_equal(count, 2);
     assert_int_equal(step, 768);
-    assert_int_equal(bytes, ((uint64_t)1536 + 1) * 2048 * 2048);
+    assert_int_equal(bytes, ((uint64_t)1536 + 1) * 2048 * 2048 + 2); /* and two pad bytes */
     test_assert_failed(ctx, umbra__slabs_plan(ctx, big, 4, 0, &lim, &count, &step, &bytes),
                        UMBRA_ERROR_OUT_OF_MEMORY,
-                       "2048 x 2048 x 1536 need 25870467072 bytes of device memory (7 slabs",
+                       "2048 x 2048 x 1536 need 25870467100 bytes of device memory (7 slabs",
                        "21474836480 bytes of global memory");
     lim.global_mem = (uint64_t)1 << 40;
     lim.max_alloc = (uint64_t)1 << 30;
     test_assert_failed(ctx, umbra__slabs_plan(ctx, big, 4, 0, &lim, &count, &step, &bytes),
-                       UMBRA_ERROR_OUT_OF_MEMORY, "need 25 slabs of at most 64 layers",
+                       UMBRA_ERROR_OUT_OF_MEMORY, "need 25 slabs of at most 63 layers",
                        "at most 8 are supported");
     lim.max_alloc = 2 * 2048 * 2048 * 4 - 1;
     test_assert_failed(ctx, umbra__slabs_plan(ctx, big, 4, 0, &lim, &count, &step, &bytes),
-                       UMBRA_ERROR_OUT_OF_MEMORY, "two z-layers (33554432 bytes)",
+                       UMBRA_ERROR_OUT_OF_MEMORY, "two z-layers (33554436 bytes)",
                        "largest buffer (33554431 bytes)");
     /* Images: the depth is split, a layer larger than the largest image is refused. */
     lim.max_alloc = (uint64_t)1 << 40;
@@ -232,11 +234,11 @@ static void test_volume_create_refuses_what_cannot_split(void **state)
     umbra_volume v = NULL;
     char want[128];
     umbra__context_limit_alloc(ctx, LAYER);
-    snprintf(want, sizeof want, "two z-layers (%zu bytes)", 2 * LAYER);
+    snprintf(want, sizeof want, "two z-layers (%zu bytes)", 2 * LAYER + sizeof(float));
     test_assert_failed(ctx, umbra_volume_create(ctx, &d, &v), UMBRA_ERROR_OUT_OF_MEMORY, want,
                        "33 x 29 x 47");
     assert_null(v);
-    umbra__context_limit_alloc(ctx, 3 * LAYER);
+    umbra__context_limit_alloc(ctx, 3 * LAYER + sizeof(float));
     test_assert_failed(ctx, umbra_volume_create(ctx, &d, &v), UMBRA_ERROR_OUT_OF_MEMORY,
                        "need 23 slabs of at most 3 layers", NULL);
     assert_null(v);
@@ -246,23 +248,52 @@ static void test_volume_create_refuses_what_cannot_split(void **state)
 
 /* ---- split against unsplit ------------------------------------------------------------------------ */
 
+static umbra_status fill_scene(void *user, void *dst, size_t bytes)
+{
+    memcpy(dst, user, bytes);
+    return UMBRA_SUCCESS;
+}
+
 static void test_split_voxels_read_back_unchanged(void **state)
 {
     umbra_context ctx = *state;
     float *voxels = scene_voxels();
     umbra_volume whole = scene_volume(ctx, voxels, 0, 1);
-    umbra_volume split = scene_volume(ctx, voxels, 7 * LAYER, 8);
+    umbra_volume split = scene_volume(ctx, voxels, 7 * LAYER + sizeof(float), 8);
     assert_int_equal(split->slab_step, 6);
-    assert_int_equal(split->device_bytes, (NZ + 7) * LAYER);
+    /* Seven shared layers and eight pad elements. */
+    assert_int_equal(split->device_bytes, (NZ + 7) * LAYER + 8 * sizeof(float));
     float *a = test_read_voxels(whole), *b = test_read_voxels(split);
     assert_memory_equal(a, b, (size_t)NX * NY * NZ * sizeof *a);
     free(a);
     free(b);
     umbra_volume_release(whole);
     umbra_volume_release(split);
+    /* umbra_volume_create_filled: one mapped buffer where the volume fits one, else slabs. */
+    umbra_volume_desc d;
+    umbra_volume_desc_init(&d);
+    d.type = UMBRA_FLOAT32;
+    d.dims[0] = NX;
+    d.dims[1] = NY;
+    d.dims[2] = NZ;
+    umbra__context_limit_alloc(ctx, 20 * LAYER + sizeof(float));
+    assert_int_equal(umbra_volume_create_filled(ctx, &d, fill_scene, voxels, &split),
+                     UMBRA_SUCCESS);
+    umbra__context_limit_alloc(ctx, 0);
+    assert_int_equal(split->slab_count, 3);
+    assert_int_equal(umbra_volume_create_filled(ctx, &d, fill_scene, voxels, &whole),
+                     UMBRA_SUCCESS);
+    assert_int_equal(whole->slab_count, 1);
+    a = test_read_voxels(whole);
+    b = test_read_voxels(split);
+    assert_memory_equal(a, b, (size_t)NX * NY * NZ * sizeof *a);
+    free(a);
+    free(b);
+    umbra_volume_release(whole);
+    umbra_volume_release(split);
     whole = scene_volume_typed(ctx, voxels, UMBRA_UINT8, 0, 1);
-    split = scene_volume_typed(ctx, voxels, UMBRA_UINT8, 7 * LAYER / 4, 8);
-    assert_int_equal(split->device_bytes, (NZ + 7) * LAYER / 4);
+    split = scene_volume_typed(ctx, voxels, UMBRA_UINT8, 7 * LAYER / 4 + 1, 8);
+    assert_int_equal(split->device_bytes, (NZ + 7) * LAYER / 4 + 8);
     a = test_read_voxels(whole);
     b = test_read_voxels(split);
     assert_memory_equal(a, b, (size_t)NX * NY * NZ * sizeof *a);
@@ -300,8 +331,9 @@ static void compare_techniques(umbra_context ctx, umbra_scalar_type type, unsign
                                uint64_t fit_layers, uint32_t slabs, double tol)
 {
     float *voxels = scene_voxels();
-    /* The limit counts float32 layers; a uint8 layer is a quarter of one. */
-    const uint64_t limit = fit_layers * LAYER / (type == UMBRA_UINT8 ? 4 : 1);
+    /* fit_layers layers and a buffer's pad element (kernels/sampling.cl reads x pairs). */
+    const size_t esize = umbra_scalar_type_size(type);
+    const uint64_t limit = fit_layers * (LAYER / sizeof(float) * esize) + esize;
     umbra_volume vols[2] = {scene_volume_typed(ctx, voxels, type, 0, 1),
                             scene_volume_typed(ctx, voxels, type, limit, slabs)};
     umbra_transfer_function tf = scene_tf(ctx);

@@ -92,7 +92,6 @@ double test_path_in_box(const double p[3], const double dir[3], const double hal
 
 float *test_read_voxels(umbra_volume vol)
 {
-    /* The device holds the volume's own type (host/volume.c), normalised as the kernels read it. */
     const size_t count = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2];
     float *out = malloc(count * sizeof *out);
     assert_non_null(out);

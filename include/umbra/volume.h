@@ -70,12 +70,26 @@ typedef struct umbra_volume_desc {
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
-/* Copies the data to the device. Blocks until the upload is done. A volume larger than the
- * device's largest allocation (or 3D image) is split into up to 8 z-slabs, drawn seamlessly;
- * UMBRA_ERROR_OUT_OF_MEMORY, naming the sizes, when it would not fit the device's global memory
- * or 8 slabs; at most 2^36 voxels. */
+/* Copies the data to the device, in its own type (1, 2 or 4 bytes per voxel; see
+ * umbra_volume_info.device_bytes). Reads desc->data once, in parallel, and keeps no pointer to
+ * it. Blocks until the upload is done. A volume larger than the device's largest allocation (or
+ * 3D image) is split into up to 8 z-slabs, drawn seamlessly; UMBRA_ERROR_OUT_OF_MEMORY, naming
+ * the sizes, when it would not fit the device's global memory or 8 slabs; at most 2^36 voxels. */
 UMBRA_API umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
                                            umbra_volume *out);
+
+/* Writes the volume's voxels, dims[0]*dims[1]*dims[2] of desc->type, x fastest, into dst (bytes
+ * long, borrowed for the call). Returns UMBRA_SUCCESS, or a failure status it has recorded on the
+ * context (umbra_context_record_error), which umbra_volume_create_filled returns. */
+typedef umbra_status (*umbra_volume_fill_fn)(void *user, void *dst, size_t bytes);
+
+/* umbra_volume_create for voxels that are not in memory yet (a file being read): desc->data must
+ * be NULL, and fill(user, dst, bytes) writes them, once, where the device reads them where it can
+ * (the buffer sampler's mapped buffer: on a CPU device the voxels then exist once, with no host
+ * copy), else into a host buffer freed before return. Blocks. */
+UMBRA_API umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_desc *desc,
+                                                  umbra_volume_fill_fn fill, void *user,
+                                                  umbra_volume *out);
 
 typedef struct umbra_volume_info {
     uint32_t dims[3];
