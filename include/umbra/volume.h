@@ -98,7 +98,11 @@ typedef struct umbra_volume_info {
     float value_min, value_max;
     uint32_t brick_size;
     uint32_t brick_counts[3];
-    size_t device_bytes;     /* device memory held by the volume and its brick table */
+    size_t device_bytes;     /* device memory held by the voxels: the input type's size per
+                                voxel (an image sampler without a UNORM format for it, or a
+                                float range too wide for float math, stores 4), plus the
+                                buffer's pad element, and for a volume in several slabs the
+                                layers neighbouring slabs share */
     int transform_given;     /* nonzero if the volume was made with an index-to-world transform */
     float origin[3];         /* world position of voxel (0, 0, 0)'s centre (also for the centred
                                 box: (0.5 - dims/2) * spacing) */
