@@ -6,7 +6,7 @@
  *    kernels pick for z;
  *  - refusals name the sizes: beyond the device's global memory, two layers over one allocation,
  *    more than UMBRA__MAX_SLABS slabs, a layer wider than the largest 3D image; the context stays
- *    usable;
+ *    usable; the NRRD reader's bound on voxels is umbra_volume_create's (2^36);
  *  - with the test knob (umbra__context_limit_alloc) a small volume is split into 3 and into 8
  *    slabs; its voxels read back as the unsplit volume's (also through
  *    umbra_volume_create_filled), and every technique's image (shaded,
@@ -246,6 +246,29 @@ static void test_volume_create_refuses_what_cannot_split(void **state)
     free(voxels);
 }
 
+/* The NRRD reader takes what umbra_volume_create takes: up to 2^36 voxels. */
+static void test_nrrd_bound_is_the_volume_bound(void **state)
+{
+    umbra_context ctx = *state;
+    char path[512];
+    test_tmp_path(path, sizeof path, "huge.nhdr");
+    test_write_text(path, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 65536 65536 17\n"
+                          "encoding: raw\ndata file: huge.raw\n");
+    umbra_volume v = NULL;
+    test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &v), UMBRA_ERROR_FORMAT,
+                       "sizes 65536 x 65536 x 17: more than 2^36 voxels", NULL);
+    assert_null(v);
+    /* 2^36 voxels exactly pass the bound: the missing data file is what fails. */
+    test_write_text(path, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 65536 65536 16\n"
+                          "encoding: raw\ndata file: huge.raw\n");
+    umbra_status st = umbra_volume_load_nrrd(ctx, path, &v);
+    assert_int_not_equal(st, UMBRA_SUCCESS);
+    assert_false(test_message_contains(ctx, "2^36"));
+    assert_null(v);
+    (void)umbra_context_take_error(ctx, NULL);
+    remove(path);
+}
+
 /* ---- split against unsplit ------------------------------------------------------------------------ */
 
 static umbra_status fill_scene(void *user, void *dst, size_t bytes)
@@ -417,6 +440,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_slab_plan_covers_every_footprint),
         cmocka_unit_test(test_slab_plan_refusals_name_the_sizes),
         cmocka_unit_test(test_volume_create_refuses_what_cannot_split),
+        cmocka_unit_test(test_nrrd_bound_is_the_volume_bound),
         cmocka_unit_test(test_split_voxels_read_back_unchanged),
         cmocka_unit_test(test_split_images_match_unsplit_buffer_sampler),
         cmocka_unit_test(test_split_images_match_unsplit_image_sampler),
