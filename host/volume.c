@@ -633,6 +633,9 @@ fail:
     if (mapped) {
         /* The kernels that will read the buffer are queued after the unmap. */
         err = clEnqueueUnmapMemObject(ctx->queue, buf, mapped, 0, NULL, NULL);
+        /* A buffer nobody will use is freed now, not whenever the queue next drains. */
+        if (st != UMBRA_SUCCESS)
+            clFinish(ctx->queue);
         if (err != CL_SUCCESS && st == UMBRA_SUCCESS) {
             umbra_volume_release(*out);
             *out = NULL;

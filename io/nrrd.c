@@ -461,6 +461,67 @@ typedef enum nrrd_encoding { ENC_RAW, ENC_GZIP, ENC_ZRL, ENC_ASCII, ENC_HEX } nr
 
 /* A 4-D array whose first axis has size 1 (a one-component "vector" volume, as some tools
  * write) is accepted as the 3-D volume it is. */
+/* Step 6 of umbra_volume_load_nrrd, the read and decode, as umbra_volume_create_filled's fill:
+ * the voxels are decoded straight into the memory the device reads. */
+typedef struct nrrd_fill {
+    umbra_context ctx;
+    const char *func, *data_name;
+    FILE *df;
+    nrrd_encoding enc;
+    size_t remaining, skip, count, type_size;
+    umbra_scalar_type type;
+    int swap;
+} nrrd_fill;
+
+static umbra_status fill_nrrd(void *user, void *dst, size_t bytes)
+{
+    nrrd_fill *F = user;
+    umbra_context ctx = F->ctx;
+    const char *func = F->func, *data_name = F->data_name;
+    const size_t remaining = F->remaining;
+    unsigned char *in = NULL;
+    umbra_status st;
+    if (F->enc == ENC_RAW) {
+        st = umbra__file_read(ctx, func, data_name, F->df, dst, bytes);
+    } else {
+        in = malloc(remaining + 1);
+        if (!in) {
+            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                               "%s: cannot allocate %zu bytes for the data of \"%s\"", func,
+                               remaining + 1, data_name);
+        }
+        st = umbra__file_read(ctx, func, data_name, F->df, in, remaining);
+        if (st != UMBRA_SUCCESS) {
+            goto fail;
+        }
+        in[remaining] = '\0';
+        switch (F->enc) {
+        case ENC_GZIP:
+            st = decode_gzip(ctx, func, data_name, in, remaining, F->skip, dst, bytes);
+            break;
+        case ENC_ZRL:
+            memset(dst, 0, bytes); /* runs of zeros are skipped, not written */
+            st = decode_zrl(ctx, func, data_name, in, remaining, dst, bytes);
+            break;
+        case ENC_HEX: st = decode_hex(ctx, func, data_name, in, remaining, dst, bytes); break;
+        default:
+            if (memchr(in, '\0', remaining)) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: \"%s\": ascii data holds a NUL byte", func, data_name);
+            } else {
+                st = decode_ascii(ctx, func, data_name, (const char *)in, F->type, dst, F->count);
+            }
+            break;
+        }
+    }
+    if (st == UMBRA_SUCCESS && F->swap) {
+        umbra__swap_bytes(dst, F->count, F->type_size);
+    }
+fail:
+    free(in);
+    return st;
+}
+
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
 {
     static const char *const enc_names[] = {"raw", "gzip", "zrl", "ascii", "hex"};
@@ -471,7 +532,6 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
     NrrdIoState *nio = NULL;
     char *biff_msg = NULL, *head = NULL, *data_path = NULL;
     const char *data_name = path;
-    unsigned char *in = NULL, *voxels = NULL;
     FILE *f = NULL, *df = NULL;
     size_t file_size = 0, got, data_size = 0, type_size, count = 1, bytes, pos, remaining;
     umbra_scalar_type type = UMBRA_UINT8;
@@ -755,59 +815,17 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         goto fail;
     }
 
-    /* 6. Read and decode. */
-    voxels = enc == ENC_ZRL ? calloc(bytes, 1) : malloc(bytes);
-    if (!voxels) {
-        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                         "%s: cannot allocate %zu bytes for the voxels of \"%s\"", func, bytes,
-                         path);
-        goto fail;
+    /* 6. Read and decode, into the device's buffer (fill_nrrd). */
+    {
+        nrrd_fill F = {ctx, func, data_name, df, enc, remaining, (size_t)byte_skip, count,
+                       type_size, type,
+                       type_size > 1 && enc != ENC_ASCII &&
+                           (endian == airEndianBig) != (umbra__host_is_big_endian() != 0)};
+        st = umbra__volume_from_fill(ctx, fill_nrrd, &F, type, dims, spacing,
+                                     placed ? origin : NULL, placed ? directions : NULL, out);
     }
-    if (enc == ENC_RAW) {
-        st = umbra__file_read(ctx, func, data_name, df, voxels, bytes);
-    } else {
-        in = malloc(remaining + 1);
-        if (!in) {
-            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                             "%s: cannot allocate %zu bytes for the data of \"%s\"", func,
-                             remaining + 1, path);
-            goto fail;
-        }
-        st = umbra__file_read(ctx, func, data_name, df, in, remaining);
-        if (st != UMBRA_SUCCESS) {
-            goto fail;
-        }
-        in[remaining] = '\0';
-        switch (enc) {
-        case ENC_GZIP:
-            st = decode_gzip(ctx, func, data_name, in, remaining, (size_t)byte_skip, voxels,
-                             bytes);
-            break;
-        case ENC_ZRL: st = decode_zrl(ctx, func, data_name, in, remaining, voxels, bytes); break;
-        case ENC_HEX: st = decode_hex(ctx, func, data_name, in, remaining, voxels, bytes); break;
-        default:
-            if (memchr(in, '\0', remaining)) {
-                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                                 "%s: \"%s\": ascii data holds a NUL byte", func, data_name);
-            } else {
-                st = decode_ascii(ctx, func, data_name, (const char *)in, type, voxels, count);
-            }
-            break;
-        }
-    }
-    if (st != UMBRA_SUCCESS) {
-        goto fail;
-    }
-    if (type_size > 1 && enc != ENC_ASCII &&
-        (endian == airEndianBig) != (umbra__host_is_big_endian() != 0)) {
-        umbra__swap_bytes(voxels, count, type_size);
-    }
-    st = umbra__volume_from_host(ctx, voxels, type, dims, spacing, placed ? origin : NULL,
-                                 placed ? directions : NULL, out);
 
 fail:
-    free(voxels);
-    free(in);
     if (df) {
         fclose(df);
     }

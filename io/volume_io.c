@@ -309,6 +309,24 @@ static umbra_status fill_raw(void *user, void *dst, size_t bytes)
     return st;
 }
 
+umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fill, void *user,
+                                     umbra_scalar_type type, const uint32_t dims[3],
+                                     const float spacing[3], const float *origin,
+                                     const float *directions, umbra_volume *out)
+{
+    umbra_volume_desc vd;
+    umbra_volume_desc_init(&vd);
+    vd.type = type;
+    memcpy(vd.dims, dims, sizeof vd.dims);
+    memcpy(vd.spacing, spacing, sizeof vd.spacing);
+    if (origin && directions) {
+        vd.transform_given = 1;
+        memcpy(vd.origin, origin, sizeof vd.origin);
+        memcpy(vd.directions, directions, sizeof vd.directions);
+    }
+    return umbra_volume_create_filled(ctx, &vd, fill, user, out);
+}
+
 /* The raw reader behind umbra_volume_load_raw and umbra_volume_load_dat; func names the public
  * function in messages. The file is read straight into the device's buffer
  * (umbra_volume_create_filled): no host copy of the voxels. */
@@ -376,12 +394,8 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     }
     raw_fill rf = {ctx, func, path, f, count, type_size,
                    type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()};
-    umbra_volume_desc vd;
-    umbra_volume_desc_init(&vd);
-    vd.type = desc->type;
-    memcpy(vd.dims, desc->dims, sizeof vd.dims);
-    memcpy(vd.spacing, desc->spacing, sizeof vd.spacing);
-    st = umbra_volume_create_filled(ctx, &vd, fill_raw, &rf, out);
+    st = umbra__volume_from_fill(ctx, fill_raw, &rf, desc->type, desc->dims, desc->spacing, NULL,
+                                 NULL, out);
 
 fail:
     if (f) {

@@ -15,7 +15,8 @@
  *  - the value range and every brick's and sub-cell's min/max equal a brute-force scan of the
  *    voxels read back from the device, for brick edges that are and are not multiples of 4;
  *  - umbra_volume_create_filled gives the volume umbra_volume_create gives for the same voxels
- *    (both samplers), returns the fill's failure as is and refuses desc->data. */
+ *    (both samplers), keeps the buffer the voxels were written into (buffer sampler: no second
+ *    copy), returns the fill's failure as is and refuses desc->data. */
 #include "internal.h" /* the volume's tables and storage */
 #include "test_util.h"
 #include "umbra_shared.h"
@@ -348,6 +349,14 @@ static void test_filled_volume_equals_created_volume(void **state)
             fill_src src = {raw, N * umbra_scalar_type_size(d.type), 0, ctxs[c]};
             assert_int_equal(umbra_volume_create_filled(ctxs[c], &d, fill_copy, &src, &b),
                              UMBRA_SUCCESS);
+            if (c == 0) {
+                /* No copy: the volume keeps the buffer the voxels were written into. */
+                cl_mem_flags flags = 0;
+                assert_int_equal(clGetMemObjectInfo(b->data, CL_MEM_FLAGS, sizeof flags, &flags,
+                                                    NULL),
+                                 CL_SUCCESS);
+                assert_true(flags & CL_MEM_ALLOC_HOST_PTR);
+            }
             umbra_volume_info ia, ib;
             assert_int_equal(umbra_volume_get_info(a, &ia), UMBRA_SUCCESS);
             assert_int_equal(umbra_volume_get_info(b, &ib), UMBRA_SUCCESS);
