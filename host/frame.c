@@ -175,27 +175,37 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
      * (the context caches both). */
     static const char *const voxel_t[] = {"uchar", "ushort", "short", "float"};
     umbra_scalar_type t = r->volume ? r->volume->stored_type : UMBRA_FLOAT32;
-    snprintf(buf, size,
-             "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s "
-             "-DUMBRA_VOXEL_CLAMPS=%d",
-             r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
-             voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32], r->volume ? r->volume->clamps : 1);
+    int n = snprintf(buf, size,
+                     "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s "
+                     "-DUMBRA_VOXEL_CLAMPS=%d",
+                     r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
+                     voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
+                     r->volume ? r->volume->clamps : 1);
+    /* A volume in several slabs: kernels/sampling.cl takes one parameter per slab. One slab adds
+     * nothing, so its programs stay those of the single-buffer code. */
+    if (r->volume && r->volume->slab_count > 1 && n > 0 && (size_t)n < size)
+        snprintf(buf + n, size - (size_t)n, " -DUMBRA_VOLUME_SLABS=%u -DUMBRA_SLAB_STEP=%u",
+                 r->volume->slab_count, r->volume->slab_step);
 }
 
 umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    cl_mem vol = r->volume->image ? r->volume->image : r->volume->data;
     cl_mem view_tf = r->view_tf_buf ? r->view_tf_buf : r->light_tf_buf;
     /* A shadow build runs before the view tables exist and does not read them: any buffer will
      * do for the argument. */
     cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_cells_buf;
-    cl_mem args[] = {r->frame_buf, vol, view_tf, r->light_tf_buf, view_bricks,
-                     r->light_cells_buf, r->shadow_buf};
-    for (cl_uint i = 0; i < sizeof args / sizeof args[0]; ++i)
+    /* VOLUME_PARAM (kernels/sampling.cl) is one parameter per slab. */
+    const cl_uint nslabs = r->volume->slab_count;
+    cl_mem args[2 + UMBRA__MAX_SLABS + 5] = {r->frame_buf};
+    memcpy(args + 1, r->volume->slabs, nslabs * sizeof(cl_mem));
+    cl_mem rest[] = {view_tf, r->light_tf_buf, view_bricks, r->light_cells_buf, r->shadow_buf};
+    memcpy(args + 1 + nslabs, rest, sizeof rest);
+    const cl_uint nargs = 1 + nslabs + (cl_uint)(sizeof rest / sizeof rest[0]);
+    for (cl_uint i = 0; i < nargs; ++i)
         UMBRA_CL(clSetKernelArg(k, i, sizeof(cl_mem), &args[i]));
-    *next = (cl_uint)(sizeof args / sizeof args[0]);
+    *next = nargs;
 fail:
     return st;
 }

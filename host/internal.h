@@ -91,6 +91,8 @@ struct umbra_context_t {
     umbra_error_callback callback;
     void *callback_user;
     atomic_uint_least64_t next_id;      /* source of volume / transfer-function ids */
+    uint64_t alloc_limit;               /* tests only (umbra__context_limit_alloc): a largest
+                                           allocation below the device's, 0 for none */
 };
 #endif
 
@@ -120,6 +122,10 @@ double umbra__now_ms(void);
 
 /* ---- volume ---------------------------------------------------------------------------------- */
 
+/* The most z-slabs a volume may be split into: each is a kernel parameter (kernels/sampling.cl
+ * spells out this many). */
+#define UMBRA__MAX_SLABS 8
+
 #ifndef __cplusplus
 struct umbra_volume_t {
     atomic_int refs;
@@ -132,10 +138,14 @@ struct umbra_volume_t {
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
     float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
                                 brick-major, x fastest (kernels/umbra_shared.h) */
-    cl_mem data;             /* voxels for the buffer sampler: the input type's raw values, or
-                                normalised float32 (stored_type FLOAT32 with value_map 0, 1, 1) */
-    cl_mem image;            /* 3D image (image sampler), or NULL: CL_R of CL_UNORM_INT8 /
-                                CL_UNORM_INT16 (int16 biased by 32768) or normalised CL_FLOAT */
+    /* The voxels on the device, in slab_count z-slabs (slab s holds the layers
+     * [s * slab_step, (s + 1) * slab_step] clipped to the grid, host/volume_slabs.c): buffers of
+     * the input type's raw values, or normalised float32 (stored_type FLOAT32 with value_map
+     * 0, 1, 1), for the buffer sampler; 3D images for the image sampler: CL_R of CL_UNORM_INT8 /
+     * CL_UNORM_INT16 (int16 biased by 32768) or normalised CL_FLOAT. */
+    cl_mem slabs[UMBRA__MAX_SLABS];
+    uint32_t slab_count;
+    uint32_t slab_step;
     umbra_scalar_type stored_type; /* element type on the device (kernels' UMBRA_VOXEL_T) */
     float value_map[3];      /* UmbraFrame.value_map: stored value s -> clamp((s [2] - [0]) [1]) */
     int clamps;              /* some stored value maps outside [0,1] (kernels' UMBRA_VOXEL_CLAMPS) */
@@ -151,9 +161,50 @@ struct umbra_volume_t {
 };
 #endif
 
-/* The volume's voxels normalised as the kernels normalise them, (s - value_map[0]) *
- * value_map[1] clamped to [0,1] for each stored value s (an image's UNORM texels as the integers
- * they encode), into out (count floats). Blocks. For the plain-C twin and tests. */
+/* What bounds a volume on a device: its largest allocation (lowered by the test knob below), its
+ * global memory and, for the image sampler, its largest 3D image (width, height, depth). */
+typedef struct umbra__device_limits {
+    uint64_t max_alloc;
+    uint64_t global_mem;
+    size_t image_max[3];
+} umbra__device_limits;
+
+/* Queries ctx's device; image_max is queried only when image is nonzero (else zeros).
+ * host/volume_slabs.c. */
+umbra_status umbra__device_limits_get(umbra_context ctx, int image, umbra__device_limits *out);
+
+/* Tests only: pretend ctx's device allocates at most bytes at once (0: the device's own limit),
+ * so that a small volume is split into slabs. Volumes created afterwards see it. */
+void umbra__context_limit_alloc(umbra_context ctx, uint64_t bytes);
+
+/* Splits dims (voxel_bytes per voxel) into the fewest z-slabs that each fit lim (one slab when
+ * the whole volume fits): *count slabs, slab s starting at layer s * *step (the step is dims[2]
+ * for one slab), *bytes on the device in all, aprons and buffers' pad elements
+ * included. UMBRA_ERROR_OUT_OF_MEMORY with a
+ * message naming the sizes when the slabs would exceed the device's global memory, two layers
+ * exceed one allocation, or more than UMBRA__MAX_SLABS slabs would be needed;
+ * UMBRA_ERROR_UNSUPPORTED when a layer is wider or taller than the device's largest 3D image. */
+umbra_status umbra__slabs_plan(umbra_context ctx, const uint32_t dims[3], size_t voxel_bytes,
+                               int image, const umbra__device_limits *lim, uint32_t *count,
+                               uint32_t *step, uint64_t *bytes);
+
+/* Creates v's slabs (sets v->slab_count, slab_step, device_bytes) for voxels of voxel_bytes
+ * each: buffers, or 3D images of format fmt when fmt is not NULL; filled from voxels (dims[0] *
+ * dims[1] * dims[2] values, x fastest, copied) unless it is NULL (the caller then writes each
+ * slab's layers, umbra__slab_layers). On failure the slabs made so far stay in v->slabs for
+ * umbra_volume_release. */
+umbra_status umbra__slabs_create(umbra_context ctx, umbra_volume v, size_t voxel_bytes,
+                                 const cl_image_format *fmt, const void *voxels);
+
+/* The voxel layers [*z0, *z1] (inclusive) that slab s of v holds. */
+void umbra__slab_layers(umbra_volume v, uint32_t s, uint32_t *z0, uint32_t *z1);
+
+/* Reads v's voxels back from its slabs into out (dims[0] * dims[1] * dims[2] values of
+ * voxel_bytes each, as the device holds them, x fastest). Blocks. */
+umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes);
+
+/* v's voxels read back and normalised to [0,1] as the kernels normalise them (voxel_normalise in
+ * kernels/sampling.cl): dims[0] * dims[1] * dims[2] floats into out, x fastest. Blocks. */
 umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);

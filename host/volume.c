@@ -100,9 +100,11 @@ static umbra_status validate(umbra_context ctx, const umbra_volume_desc *d)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: dims %u x %u x %u: every size must be > 0", fn, d->dims[0],
                            d->dims[1], d->dims[2]);
-    if ((uint64_t)d->dims[0] * d->dims[1] * d->dims[2] > ((uint64_t)1 << 32))
+    /* A bound on what a caller can make large: 2^36 float voxels are 256 GiB, more than any
+     * device holds (the device's own memory is checked before anything is uploaded). */
+    if ((uint64_t)d->dims[0] * d->dims[1] * d->dims[2] > ((uint64_t)1 << 36))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: dims %u x %u x %u: more than 2^32 voxels", fn, d->dims[0],
+                           "%s: dims %u x %u x %u: more than 2^36 voxels", fn, d->dims[0],
                            d->dims[1], d->dims[2]);
     for (int a = 0; a < 3; ++a)
         if (!(d->spacing[a] > 0.0f) || !isfinite(d->spacing[a]))
@@ -266,52 +268,37 @@ static void convert_voxels(const void *src, umbra_scalar_type type, size_t first
     }
 }
 
-/* Creates v->data or v->image from the caller's voxels: straight from them where the device
- * stores the input as it is, else through a bounded staging buffer (a few MiB), never a
- * converted copy of the whole volume. Blocks until the data is on the device. */
+/* Creates v's slabs (one buffer or image unless the volume exceeds the device's largest,
+ * host/volume_slabs.c) from the caller's voxels: straight from them where the device stores the
+ * input as it is, else through a bounded staging buffer (a few MiB), never a converted copy of
+ * the whole volume. Blocks until the data is on the device. */
 static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, cl_mem filled,
                            stored_form form, double lo, double scale)
 {
     umbra_context ctx = v->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const size_t nx = v->dims[0], ny = v->dims[1], nz = v->dims[2], count = nx * ny * nz;
+    const size_t nx = v->dims[0], ny = v->dims[1];
     const size_t esize = umbra_scalar_type_size(v->stored_type);
-    const cl_mem_flags direct = form == STORED_RAW ? CL_MEM_COPY_HOST_PTR : 0;
-    void *host = form == STORED_RAW ? (void *)desc->data : NULL;
     void *stage = NULL;
-    cl_int err;
     if (filled && form == STORED_RAW) {
-        /* desc->data is filled's mapping: the buffer already holds the voxels as stored. */
+        /* desc->data is filled's mapping: the buffer already holds the voxels as stored (and
+         * umbra_volume_create_filled maps one only for a volume that fits one buffer). */
         clRetainMemObject(filled);
-        v->data = filled;
+        v->slabs[0] = filled;
+        v->slab_count = 1;
+        v->slab_step = v->dims[2];
+        /* The buffer has one pad element (host/volume_slabs.c). */
+        v->device_bytes = ((size_t)v->dims[0] * v->dims[1] * v->dims[2] + 1) * esize;
         return UMBRA_SUCCESS;
     }
-    if (ctx->sampler == UMBRA_SAMPLER_IMAGE) {
-        cl_image_format fmt = {CL_R, v->stored_type == UMBRA_UINT8    ? CL_UNORM_INT8
-                                     : v->stored_type == UMBRA_UINT16 ? CL_UNORM_INT16
-                                                                      : CL_FLOAT};
-        cl_image_desc idesc;
-        memset(&idesc, 0, sizeof idesc);
-        idesc.image_type = CL_MEM_OBJECT_IMAGE3D;
-        idesc.image_width = nx;
-        idesc.image_height = ny;
-        idesc.image_depth = nz;
-        v->image = clCreateImage(ctx->cl_ctx, CL_MEM_READ_ONLY | direct, &fmt, &idesc, host, &err);
-        UMBRA_CL_CHECK(err, "clCreateImage(volume)");
-    } else {
-        /* One element more than the voxels: the sampler reads voxels in x pairs (vload2), and
-         * the pair of the last voxel reads one beyond it, with weight 0. */
-        v->data = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY, (count + 1) * esize, NULL, &err);
-        UMBRA_CL_CHECK(err, "clCreateBuffer(volume)");
-        const float zero = 0.0f; /* a finite pad: weight 0 times anything else could be NaN */
-        UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->data, CL_TRUE, count * esize, esize, &zero, 0,
-                                      NULL, NULL));
-        if (form == STORED_RAW)
-            UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->data, CL_TRUE, 0, count * esize, host, 0,
-                                          NULL, NULL));
-    }
-    if (form == STORED_RAW)
-        goto fail; /* done: st is UMBRA_SUCCESS */
+    const cl_image_format fmt = {CL_R, v->stored_type == UMBRA_UINT8    ? CL_UNORM_INT8
+                                       : v->stored_type == UMBRA_UINT16 ? CL_UNORM_INT16
+                                                                        : CL_FLOAT};
+    const int image = ctx->sampler == UMBRA_SAMPLER_IMAGE;
+    st = umbra__slabs_create(ctx, v, esize, image ? &fmt : NULL,
+                             form == STORED_RAW ? desc->data : NULL);
+    if (st != UMBRA_SUCCESS || form == STORED_RAW)
+        return st;
     /* Whole rows of one slice per write (an image region is a box). */
     const size_t rows = nx >= ((size_t)1 << 20) ? 1 : ((size_t)1 << 20) / nx;
     stage = malloc((rows < ny ? rows : ny) * nx * esize);
@@ -321,19 +308,25 @@ static umbra_status upload(umbra_volume v, const umbra_volume_desc *desc, cl_mem
                          "bytes", (rows < ny ? rows : ny) * nx * esize);
         goto fail;
     }
-    for (size_t z = 0; z < nz; ++z)
-        for (size_t y = 0; y < ny; y += rows) {
-            size_t r = ny - y < rows ? ny - y : rows, first = (z * ny + y) * nx;
-            convert_voxels(desc->data, desc->type, first, r * nx, form, lo, scale, stage);
-            if (v->image) {
-                size_t origin[3] = {0, y, z}, region[3] = {nx, r, 1};
-                UMBRA_CL(clEnqueueWriteImage(ctx->queue, v->image, CL_TRUE, origin, region, 0, 0,
-                                             stage, 0, NULL, NULL));
-            } else {
-                UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->data, CL_TRUE, first * esize,
-                                              r * nx * esize, stage, 0, NULL, NULL));
+    /* Slab by slab: the layer two slabs share is converted for each. */
+    for (uint32_t s = 0; s < v->slab_count; ++s) {
+        uint32_t z0, z1;
+        umbra__slab_layers(v, s, &z0, &z1);
+        for (size_t z = z0; z <= z1; ++z)
+            for (size_t y = 0; y < ny; y += rows) {
+                size_t r = ny - y < rows ? ny - y : rows, first = (z * ny + y) * nx;
+                convert_voxels(desc->data, desc->type, first, r * nx, form, lo, scale, stage);
+                if (image) {
+                    size_t origin[3] = {0, y, z - z0}, region[3] = {nx, r, 1};
+                    UMBRA_CL(clEnqueueWriteImage(ctx->queue, v->slabs[s], CL_TRUE, origin, region,
+                                                 0, 0, stage, 0, NULL, NULL));
+                } else {
+                    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, v->slabs[s], CL_TRUE,
+                                                  ((z - z0) * ny + y) * nx * esize, r * nx * esize,
+                                                  stage, 0, NULL, NULL));
+                }
             }
-        }
+    }
 fail:
     free(stage);
     return st;
@@ -346,6 +339,19 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
     umbra_status st = validate(ctx, desc);
     if (st != UMBRA_SUCCESS)
         return st;
+    /* A volume that cannot fit the device is refused before the pass over its voxels. The
+     * device stores at least the input type's bytes per voxel (or float32 in its place); the
+     * upload plans again with the stored type. */
+    {
+        umbra__device_limits lim;
+        uint32_t nslabs, step;
+        uint64_t bytes;
+        const int image = ctx->sampler == UMBRA_SAMPLER_IMAGE;
+        if ((st = umbra__device_limits_get(ctx, image, &lim)) != UMBRA_SUCCESS ||
+            (st = umbra__slabs_plan(ctx, desc->dims, umbra_scalar_type_size(desc->type), image,
+                                    &lim, &nslabs, &step, &bytes)) != UMBRA_SUCCESS)
+            return st;
+    }
 
     box_job cells = {0}, bricks = {0};
     uint32_t *intervals = NULL;
@@ -528,8 +534,6 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *de
 
     if ((st = upload(v, desc, filled, form, lo, scale)) != UMBRA_SUCCESS)
         goto fail;
-    /* The buffer has one pad element (see upload). */
-    v->device_bytes = (count + (v->data ? 1 : 0)) * umbra_scalar_type_size(v->stored_type);
     free(intervals);
     *out = v;
     return UMBRA_SUCCESS;
@@ -580,7 +584,18 @@ umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_de
     cl_mem buf = NULL;
     void *host = NULL, *mapped = NULL;
     cl_int err;
-    if (ctx->sampler == UMBRA_SAMPLER_BUFFER) {
+    /* One mapped buffer only for a volume that fits one (host/volume_slabs.c); the slabs of a
+     * larger one are filled from host memory, as an image is. */
+    umbra__device_limits lim;
+    uint32_t nslabs = 1, step;
+    uint64_t need;
+    if ((st = umbra__device_limits_get(ctx, ctx->sampler == UMBRA_SAMPLER_IMAGE, &lim)) !=
+            UMBRA_SUCCESS ||
+        (st = umbra__slabs_plan(ctx, d.dims, umbra_scalar_type_size(d.type),
+                                ctx->sampler == UMBRA_SAMPLER_IMAGE, &lim, &nslabs, &step,
+                                &need)) != UMBRA_SUCCESS)
+        return st;
+    if (ctx->sampler == UMBRA_SAMPLER_BUFFER && nslabs == 1) {
         /* The device's own buffer, mapped: on a CPU device the mapping is the buffer itself,
          * so the voxels are written once, where the kernels read them. */
         buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR,
@@ -602,7 +617,7 @@ umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_de
         }
         d.data = mapped;
     } else {
-        /* An image is made from host memory: the voxels go there first. */
+        /* An image (or slabs) is made from host memory: the voxels go there first. */
         host = malloc(bytes);
         if (!host) {
             st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
@@ -631,38 +646,6 @@ fail:
     if (buf)
         clReleaseMemObject(buf);
     free(host);
-    return st;
-}
-
-umbra_status umbra__volume_read_normalised(umbra_volume v, float *out)
-{
-    umbra_context ctx = v->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    const size_t count = (size_t)v->dims[0] * v->dims[1] * v->dims[2];
-    const size_t esize = umbra_scalar_type_size(v->stored_type);
-    /* Floats read in place; narrower types into the end of out, so that the conversion running
-     * forwards never overwrites a value it has yet to read. */
-    unsigned char *raw = (unsigned char *)out + count * (sizeof *out - esize);
-    if (v->data) {
-        UMBRA_CL(clEnqueueReadBuffer(ctx->queue, v->data, CL_TRUE, 0, count * esize, raw, 0, NULL,
-                                     NULL));
-    } else {
-        size_t origin[3] = {0, 0, 0}, region[3] = {v->dims[0], v->dims[1], v->dims[2]};
-        UMBRA_CL(clEnqueueReadImage(ctx->queue, v->image, CL_TRUE, origin, region, 0, 0, raw, 0,
-                                    NULL, NULL));
-    }
-    for (size_t i = 0; i < count; ++i) {
-        float s;
-        switch (v->stored_type) {
-        case UMBRA_UINT8: s = (float)raw[i]; break;
-        case UMBRA_UINT16: { uint16_t u; memcpy(&u, raw + 2 * i, 2); s = (float)u; break; }
-        case UMBRA_INT16: { int16_t u; memcpy(&u, raw + 2 * i, 2); s = (float)u; break; }
-        default: memcpy(&s, raw + 4 * i, 4); break;
-        }
-        float x = (s - v->value_map[0]) * v->value_map[1];
-        out[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
-    }
-fail:
     return st;
 }
 
@@ -705,10 +688,9 @@ void umbra_volume_release(umbra_volume v)
 {
     if (!v || atomic_fetch_sub(&v->refs, 1) > 1)
         return;
-    if (v->data)
-        clReleaseMemObject(v->data);
-    if (v->image)
-        clReleaseMemObject(v->image);
+    for (int s = 0; s < UMBRA__MAX_SLABS; ++s)
+        if (v->slabs[s])
+            clReleaseMemObject(v->slabs[s]);
     free(v->brick_minmax);
     free(v->cell_minmax);
     umbra_context_release(v->ctx);

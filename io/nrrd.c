@@ -642,16 +642,18 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         }
         dims[i] = (uint32_t)size;
         spacing[i] = nrrd_axis_spacing(nrrd, first_axis + i);
-        count *= size; /* no overflow: the product of three 32-bit sizes is checked below */
-        if (count > ((size_t)1 << 32)) {
+        /* umbra_volume_create's bound (volumes beyond one device allocation are split),
+         * checked before the product so that it cannot overflow. */
+        if (size > ((size_t)1 << 36) / count) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                             "%s: \"%s\": sizes %zu x %zu x %zu: more than 2^32 voxels (the "
+                             "%s: \"%s\": sizes %zu x %zu x %zu: more than 2^36 voxels (the "
                              "limit)",
                              func, path, nrrd->axis[first_axis].size,
                              nrrd->axis[first_axis + 1].size,
                              first_axis + 2 < nrrd->dim ? nrrd->axis[first_axis + 2].size : 0);
             goto fail;
         }
+        count *= size;
     }
     /* With space directions the file places the volume in its world (spacing: their lengths). */
     placed = nrrd_transform(nrrd, first_axis, spacing, origin, directions);

@@ -15,7 +15,18 @@
  * frame); where a given range clamps voxels, the buffer path maps each of the eight corners
  * before blending, so values outside the range clamp before they blend, as the float volume
  * did. The image path's filter always blends first: the host stores a normalised float image
- * instead wherever that would differ (host/volume.c). */
+ * instead wherever that would differ (host/volume.c).
+ *
+ * A volume larger than one device allocation (or, for images, deeper than the device's largest
+ * 3D image) lives in UMBRA_VOLUME_SLABS z-slabs (host/volume_slabs.c): slab s holds the voxel
+ * layers [s * UMBRA_SLAB_STEP, (s + 1) * UMBRA_SLAB_STEP], the last one clipped to the grid, so
+ * neighbouring slabs share one layer (the apron). A trilinear sample reads the layers floor(z) and
+ * floor(z) + 1, which always lie in the slab floor(z) / UMBRA_SLAB_STEP; the gradient is built
+ * from such samples, so neither ever straddles two slabs and a split volume samples exactly as an
+ * unsplit one. OpenCL C 1.2 has no arrays of buffers or images: the slabs are separate kernel
+ * parameters (VOLUME_PARAM), and the macro `vol` names all of them, so every kernel passes its
+ * volume on as `vol` however many slabs there are. One slab (the default) compiles to exactly
+ * the single-buffer code. */
 
 #ifndef UMBRA_SAMPLER_IMAGE
 #define UMBRA_SAMPLER_IMAGE 0
@@ -26,6 +37,15 @@
 #ifndef UMBRA_VOXEL_CLAMPS
 #define UMBRA_VOXEL_CLAMPS 1
 #endif
+#ifndef UMBRA_VOLUME_SLABS
+#define UMBRA_VOLUME_SLABS 1
+#endif
+#if UMBRA_VOLUME_SLABS < 1 || UMBRA_VOLUME_SLABS > 8
+#error "UMBRA_VOLUME_SLABS must lie in [1, 8] (UMBRA__MAX_SLABS in host/internal.h)"
+#endif
+#if UMBRA_VOLUME_SLABS > 1 && !defined(UMBRA_SLAB_STEP)
+#error "a volume in several slabs needs UMBRA_SLAB_STEP (voxel layers from one slab to the next)"
+#endif
 
 /* A stored value (a raw voxel, or a UNORM image's value in [0,1]) mapped to [0,1]. */
 UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
@@ -34,7 +54,35 @@ UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
 }
 
 #if UMBRA_SAMPLER_IMAGE
+#define UMBRA_SLAB_PARAM(i) __read_only image3d_t vol_##i
+#else
+#define UMBRA_SLAB_PARAM(i) __global const UMBRA_VOXEL_T *restrict vol_##i
+#endif
+#define UMBRA_SLAB_NAME(i) vol_##i
+#define UMBRA_SLABS_1(M) M(0)
+#define UMBRA_SLABS_2(M) UMBRA_SLABS_1(M), M(1)
+#define UMBRA_SLABS_3(M) UMBRA_SLABS_2(M), M(2)
+#define UMBRA_SLABS_4(M) UMBRA_SLABS_3(M), M(3)
+#define UMBRA_SLABS_5(M) UMBRA_SLABS_4(M), M(4)
+#define UMBRA_SLABS_6(M) UMBRA_SLABS_5(M), M(5)
+#define UMBRA_SLABS_7(M) UMBRA_SLABS_6(M), M(6)
+#define UMBRA_SLABS_8(M) UMBRA_SLABS_7(M), M(7)
+#define UMBRA_SLABS_(n, M) UMBRA_SLABS_##n(M)
+#define UMBRA_SLABS(n, M) UMBRA_SLABS_(n, M)
+
+#if UMBRA_VOLUME_SLABS == 1
+#if UMBRA_SAMPLER_IMAGE
 #define VOLUME_PARAM __read_only image3d_t vol
+#else
+#define VOLUME_PARAM __global const UMBRA_VOXEL_T *restrict vol
+#endif
+#else
+#define VOLUME_PARAM UMBRA_SLABS(UMBRA_VOLUME_SLABS, UMBRA_SLAB_PARAM)
+#define vol UMBRA_SLABS(UMBRA_VOLUME_SLABS, UMBRA_SLAB_NAME)
+#endif
+
+#if UMBRA_SAMPLER_IMAGE
+#if UMBRA_VOLUME_SLABS == 1
 __constant sampler_t umbra_linear =
     CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_CLAMP_TO_EDGE | CLK_FILTER_LINEAR;
 
@@ -44,26 +92,67 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     return voxel_normalise(g, read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x);
 }
 #else
-#define VOLUME_PARAM __global const UMBRA_VOXEL_T *restrict vol
+/* Unnormalised coordinates: voxel i's centre is at i + 0.5 in its slab's image. */
+__constant sampler_t umbra_linear =
+    CLK_NORMALIZED_COORDS_FALSE | CLK_ADDRESS_CLAMP_TO_EDGE | CLK_FILTER_LINEAR;
 
-/* Voxel i (x fastest) of the buffer, ready to blend: normalised where the range clamps, else
- * as stored (voxel_blended maps the blend). The one place the buffer is read. */
-UMBRA_INLINE float voxel_load(VOLUME_PARAM, VolGeom g, size_t i)
+/* Images cannot be held in variables or chosen with ?: in OpenCL C 1.2: one read per case. */
+#define UMBRA_SLAB_READ(i)                                                                     \
+    case i:                                                                                    \
+        return voxel_normalise(g, read_imagef(vol_##i, umbra_linear, c).x);
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    int s = min((int)x.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    float4 c = (float4)(x.x + 0.5f, x.y + 0.5f, x.z - (float)(s * UMBRA_SLAB_STEP) + 0.5f, 0.0f);
+    switch (s) {
+        UMBRA_SLAB_READ(0)
+        UMBRA_SLAB_READ(1)
+#if UMBRA_VOLUME_SLABS > 2
+        UMBRA_SLAB_READ(2)
+#endif
+#if UMBRA_VOLUME_SLABS > 3
+        UMBRA_SLAB_READ(3)
+#endif
+#if UMBRA_VOLUME_SLABS > 4
+        UMBRA_SLAB_READ(4)
+#endif
+#if UMBRA_VOLUME_SLABS > 5
+        UMBRA_SLAB_READ(5)
+#endif
+#if UMBRA_VOLUME_SLABS > 6
+        UMBRA_SLAB_READ(6)
+#endif
+#if UMBRA_VOLUME_SLABS > 7
+        UMBRA_SLAB_READ(7)
+#endif
+    }
+    return 0.0f;
+}
+#endif
+#else
+/* Voxel i (x fastest) of one buffer (the volume or a slab), ready to blend: normalised where
+ * the range clamps, else as stored (voxel_blended maps the blend). The one place the buffer is
+ * read. */
+UMBRA_INLINE float voxel_load(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t i)
 {
 #if UMBRA_VOXEL_CLAMPS
-    return voxel_normalise(g, convert_float(vol[i]));
+    return voxel_normalise(g, convert_float(v[i]));
 #else
-    return convert_float(vol[i]);
+    return convert_float(v[i]);
 #endif
 }
 
-UMBRA_INLINE float2 voxel_load2(VOLUME_PARAM, VolGeom g, size_t i)
+/* Voxels i and i + 1 (every buffer has a pad element after its last voxel, host/
+ * volume_slabs.c). */
+UMBRA_INLINE float2 voxel_load2(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t i)
 {
 #if UMBRA_VOXEL_CLAMPS
-    float2 s = convert_float2(vload2(0, vol + i));
+    float2 s = convert_float2(vload2(0, v + i));
     return (float2)(voxel_normalise(g, s.x), voxel_normalise(g, s.y));
 #else
-    return convert_float2(vload2(0, vol + i));
+    return convert_float2(vload2(0, v + i));
 #endif
 }
 
@@ -84,11 +173,39 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     float3 f = x - fl;
     int3 i0 = convert_int3(fl);
     int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_VOLUME_SLABS == 1
+    __global const UMBRA_VOXEL_T *restrict v = vol;
+#else
+    /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
+    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    __global const UMBRA_VOXEL_T *v = vol_0;
+    v = s == 1 ? vol_1 : v;
+#if UMBRA_VOLUME_SLABS > 2
+    v = s == 2 ? vol_2 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 3
+    v = s == 3 ? vol_3 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 4
+    v = s == 4 ? vol_4 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 5
+    v = s == 5 ? vol_5 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 6
+    v = s == 6 ? vol_6 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 7
+    v = s == 7 ? vol_7 : v;
+#endif
+    i0.z -= s * UMBRA_SLAB_STEP;
+    i1.z -= s * UMBRA_SLAB_STEP;
+#endif
     size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float2 c0 = voxel_load2(vol, g, z0 + y0 + i0.x), c1 = voxel_load2(vol, g, z0 + y1 + i0.x);
-    float2 c2 = voxel_load2(vol, g, z1 + y0 + i0.x), c3 = voxel_load2(vol, g, z1 + y1 + i0.x);
+    float2 c0 = voxel_load2(v, g, z0 + y0 + i0.x), c1 = voxel_load2(v, g, z0 + y1 + i0.x);
+    float2 c2 = voxel_load2(v, g, z1 + y0 + i0.x), c3 = voxel_load2(v, g, z1 + y1 + i0.x);
     float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
     float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
     return voxel_blended(g, mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z));

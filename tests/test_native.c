@@ -352,8 +352,8 @@ static void test_filled_volume_equals_created_volume(void **state)
             if (c == 0) {
                 /* No copy: the volume keeps the buffer the voxels were written into. */
                 cl_mem_flags flags = 0;
-                assert_int_equal(clGetMemObjectInfo(b->data, CL_MEM_FLAGS, sizeof flags, &flags,
-                                                    NULL),
+                assert_int_equal(clGetMemObjectInfo(b->slabs[0], CL_MEM_FLAGS, sizeof flags,
+                                                    &flags, NULL),
                                  CL_SUCCESS);
                 assert_true(flags & CL_MEM_ALLOC_HOST_PTR);
             }

@@ -72,7 +72,9 @@ UMBRA_API void umbra_volume_desc_init(umbra_volume_desc *desc);
 
 /* Copies the data to the device, in its own type (1, 2 or 4 bytes per voxel; see
  * umbra_volume_info.device_bytes). Reads desc->data once, in parallel, and keeps no pointer to
- * it. Blocks until the upload is done. */
+ * it. Blocks until the upload is done. A volume larger than the device's largest allocation (or
+ * 3D image) is split into up to 8 z-slabs, drawn seamlessly; UMBRA_ERROR_OUT_OF_MEMORY, naming
+ * the sizes, when it would not fit the device's global memory or 8 slabs; at most 2^36 voxels. */
 UMBRA_API umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *desc,
                                            umbra_volume *out);
 
@@ -98,7 +100,9 @@ typedef struct umbra_volume_info {
     uint32_t brick_counts[3];
     size_t device_bytes;     /* device memory held by the voxels: the input type's size per
                                 voxel (an image sampler without a UNORM format for it, or a
-                                float range too wide for float math, stores 4) */
+                                float range too wide for float math, stores 4), plus the
+                                buffer's pad element, and for a volume in several slabs the
+                                layers neighbouring slabs share */
     int transform_given;     /* nonzero if the volume was made with an index-to-world transform */
     float origin[3];         /* world position of voxel (0, 0, 0)'s centre (also for the centred
                                 box: (0.5 - dims/2) * spacing) */
