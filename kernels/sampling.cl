@@ -212,9 +212,11 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 }
 #endif
 
-#if UMBRA_SAMPLER_IMAGE
-/* Central-difference gradient, one voxel each way, in value per world unit (six filtered reads:
- * the texture hardware interpolates). */
+#if UMBRA_SAMPLER_IMAGE || UMBRA_VOLUME_SLABS > 1
+/* Central-difference gradient, one voxel each way, in value per world unit: six samples (on the
+ * image back end six filtered reads, the texture hardware interpolates). A volume in several
+ * slabs takes this form on the buffer back end too: each sample lies in one slab, while the
+ * 32-voxel stencil below spans four layers, which can straddle a slab's one-layer apron. */
 inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 s = g.spacing;
@@ -238,6 +240,7 @@ inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * the six samples only by float rounding, and less of it: the differences are taken before the
  * interpolation, not between two interpolated values (tests/test_raycast.c bounds the image
  * change against the six-sample form). */
+#define VX(i) voxel_load(vol, g, i) /* voxel i, through the one buffer read */
 UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
 {
     /* Clamped to one voxel past the border, where every difference is 0 either way, so the
@@ -256,26 +259,34 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
     size_t za = (size_t)a.z * sz, zb = (size_t)b.z * sz;
     size_t zc = (size_t)c.z * sz, zd = (size_t)d.z * sz;
     /* p's cell: the corners (b or c per axis) */
-    float v_bbb = vol[zb + yb + xb], v_cbb = vol[zb + yb + xc];
-    float v_bcb = vol[zb + yc + xb], v_ccb = vol[zb + yc + xc];
-    float v_bbc = vol[zc + yb + xb], v_cbc = vol[zc + yb + xc];
-    float v_bcc = vol[zc + yc + xb], v_ccc = vol[zc + yc + xc];
+    float v_bbb = VX(zb + yb + xb), v_cbb = VX(zb + yb + xc);
+    float v_bcb = VX(zb + yc + xb), v_ccb = VX(zb + yc + xc);
+    float v_bbc = VX(zc + yb + xb), v_cbc = VX(zc + yb + xc);
+    float v_bcc = VX(zc + yc + xb), v_ccc = VX(zc + yc + xc);
     /* along x: the differences at x = b (v[c] - v[a]) and x = c (v[d] - v[b]), mixed by f.x */
-    float dx_bb = mix(v_cbb - vol[zb + yb + xa], vol[zb + yb + xd] - v_bbb, f.x);
-    float dx_cb = mix(v_ccb - vol[zb + yc + xa], vol[zb + yc + xd] - v_bcb, f.x);
-    float dx_bc = mix(v_cbc - vol[zc + yb + xa], vol[zc + yb + xd] - v_bbc, f.x);
-    float dx_cc = mix(v_ccc - vol[zc + yc + xa], vol[zc + yc + xd] - v_bcc, f.x);
+    float dx_bb = mix(v_cbb - VX(zb + yb + xa), VX(zb + yb + xd) - v_bbb, f.x);
+    float dx_cb = mix(v_ccb - VX(zb + yc + xa), VX(zb + yc + xd) - v_bcb, f.x);
+    float dx_bc = mix(v_cbc - VX(zc + yb + xa), VX(zc + yb + xd) - v_bbc, f.x);
+    float dx_cc = mix(v_ccc - VX(zc + yc + xa), VX(zc + yc + xd) - v_bcc, f.x);
     float gx = mix(mix(dx_bb, dx_cb, f.y), mix(dx_bc, dx_cc, f.y), f.z);
-    float dy_bb = mix(v_bcb - vol[zb + ya + xb], vol[zb + yd + xb] - v_bbb, f.y);
-    float dy_cb = mix(v_ccb - vol[zb + ya + xc], vol[zb + yd + xc] - v_cbb, f.y);
-    float dy_bc = mix(v_bcc - vol[zc + ya + xb], vol[zc + yd + xb] - v_bbc, f.y);
-    float dy_cc = mix(v_ccc - vol[zc + ya + xc], vol[zc + yd + xc] - v_cbc, f.y);
+    float dy_bb = mix(v_bcb - VX(zb + ya + xb), VX(zb + yd + xb) - v_bbb, f.y);
+    float dy_cb = mix(v_ccb - VX(zb + ya + xc), VX(zb + yd + xc) - v_cbb, f.y);
+    float dy_bc = mix(v_bcc - VX(zc + ya + xb), VX(zc + yd + xb) - v_bbc, f.y);
+    float dy_cc = mix(v_ccc - VX(zc + ya + xc), VX(zc + yd + xc) - v_cbc, f.y);
     float gy = mix(mix(dy_bb, dy_cb, f.x), mix(dy_bc, dy_cc, f.x), f.z);
-    float dz_bb = mix(v_bbc - vol[za + yb + xb], vol[zd + yb + xb] - v_bbb, f.z);
-    float dz_cb = mix(v_cbc - vol[za + yb + xc], vol[zd + yb + xc] - v_cbb, f.z);
-    float dz_bc = mix(v_bcc - vol[za + yc + xb], vol[zd + yc + xb] - v_bcb, f.z);
-    float dz_cc = mix(v_ccc - vol[za + yc + xc], vol[zd + yc + xc] - v_ccb, f.z);
+    float dz_bb = mix(v_bbc - VX(za + yb + xb), VX(zd + yb + xb) - v_bbb, f.z);
+    float dz_cb = mix(v_cbc - VX(za + yb + xc), VX(zd + yb + xc) - v_cbb, f.z);
+    float dz_bc = mix(v_bcc - VX(za + yc + xb), VX(zd + yc + xb) - v_bcb, f.z);
+    float dz_cc = mix(v_ccc - VX(za + yc + xc), VX(zd + yc + xc) - v_ccb, f.z);
     float gz = mix(mix(dz_bb, dz_cb, f.x), mix(dz_bc, dz_cc, f.x), f.y);
-    return (float3)(gx, gy, gz) * 0.5f * g.inv_spacing;
+    /* Where voxel_load gives stored values (no voxel clamps), the differences are of stored
+     * values: the normalisation is linear there, so its slope scales them once. */
+#if UMBRA_VOXEL_CLAMPS
+    const float slope = 1.0f;
+#else
+    const float slope = g.image_scale * g.value_scale;
+#endif
+    return (float3)(gx, gy, gz) * (0.5f * slope) * g.inv_spacing;
 }
+#undef VX
 #endif
