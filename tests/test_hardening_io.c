@@ -265,8 +265,12 @@ static size_t heap_growth_of_failing_loads(umbra_context ctx, const char *path, 
     umbra_volume vol = NULL;
     size_t before;
     int i;
-    /* Warm-up: anything allocated once (locale data, zlib tables) is not a leak. */
-    for (i = 0; i < 2; ++i) {
+    /* Warm-up: anything allocated once (locale data, zlib tables) is not a leak, nor are the
+     * pools PoCL fills over the first loads now that a load maps a device buffer to decode into
+     * (measured with the corrupt gzip file: 10.5 kB grown over the 40 loads after 2 warm-ups,
+     * and as much over 200, so a pool and not a leak; 0 over 40 and 384 bytes over 200 after 20
+     * warm-ups). */
+    for (i = 0; i < 20; ++i) {
         assert_int_equal(umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT);
         umbra_context_take_error(ctx, NULL);
     }
@@ -300,10 +304,11 @@ static void test_corrupt_gzip_and_zrl_nrrd_fail_without_leaking(void **state)
     test_write_bytes(tmp_path(path, "corrupt_gzip.nrrd"), file, sizeof gz_head - 1 + sizeof gz_body);
     test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "corrupt gzip data", path);
-    grown = heap_growth_of_failing_loads(ctx, path, 40);
-    print_message("corrupt gzip: heap grew %zu bytes over 40 failing loads\n", grown);
-    /* Teem leaked 23.5 kB a load here (940 kB over 40). */
-    assert_true(grown < 4096);
+    /* 400 loads against 8 kB: a leak of 21 bytes a load fails, while what PoCL's threads hold
+     * at the moment of the reading (up to 3.7 kB seen) passes. Teem leaked 23.5 kB a load here. */
+    grown = heap_growth_of_failing_loads(ctx, path, 400);
+    print_message("corrupt gzip: heap grew %zu bytes over 400 failing loads\n", grown);
+    assert_true(grown < 8192);
     remove(path);
 
     memcpy(file, zrl_head, sizeof zrl_head - 1);
@@ -311,9 +316,9 @@ static void test_corrupt_gzip_and_zrl_nrrd_fail_without_leaking(void **state)
     test_write_bytes(tmp_path(path, "malformed.nrrd"), file, sizeof zrl_head - 1 + sizeof zrl_body);
     test_assert_failed(ctx, umbra_volume_load_nrrd(ctx, path, &vol), UMBRA_ERROR_FORMAT,
                    "malformed ZRL data", path);
-    grown = heap_growth_of_failing_loads(ctx, path, 40);
-    print_message("malformed ZRL: heap grew %zu bytes over 40 failing loads\n", grown);
-    assert_true(grown < 4096);
+    grown = heap_growth_of_failing_loads(ctx, path, 400);
+    print_message("malformed ZRL: heap grew %zu bytes over 400 failing loads\n", grown);
+    assert_true(grown < 8192);
     /* A header missing a required field: refused before Teem, whose consistency check would
      * leak 88 bytes a load on this path. */
     test_write_text(path, "NRRD0004\ntype: ushort\ndimension: 3\nendian: little\nencoding: raw\n\n");
