@@ -483,31 +483,6 @@ static void nim_write(nifti_image *nim, const char *path)
     nifti_image_free(nim);
 }
 
-/* vol has dims, spacing, range [lo, hi] and voxels (want[i] - lo) / (hi - lo). */
-static void assert_volume(umbra_volume vol, const uint32_t dims[3], const float spacing[3],
-                          const double *want, double lo, double hi)
-{
-    umbra_volume_info info;
-    size_t count = (size_t)dims[0] * dims[1] * dims[2], i;
-    float *vox;
-    assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
-    for (i = 0; i < 3; ++i) {
-        assert_int_equal(info.dims[i], dims[i]);
-        assert_float_equal(info.spacing[i], spacing[i], 1e-6);
-    }
-    assert_float_equal(info.value_min, lo, 1e-3);
-    assert_float_equal(info.value_max, hi, 1e-3);
-    vox = test_read_voxels(vol);
-    for (i = 0; i < count; ++i) {
-        double w = (want[i] - lo) / (hi - lo);
-        if (fabs(vox[i] - w) > 1e-6) {
-            print_message("voxel %zu: %.9g, expected %.9g\n", i, (double)vox[i], w);
-        }
-        assert_float_equal(vox[i], w, 1e-6);
-    }
-    free(vox);
-}
-
 /* uint8 NIfTI-1 .nii and uint16 NIfTI-2 .nii.gz through umbra_volume_load, spacing from
  * pixdim. */
 static void test_nifti_loads_nii_and_gz(void **state)
@@ -538,7 +513,7 @@ static void test_nifti_loads_nii_and_gz(void **state)
         }
         nim_write(nim, tmp_path(path, pass ? "v2.nii.gz" : "v1.nii"));
         assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
-        assert_volume(vol, dims, spacing, want, pass ? 7.0 : 0.0, pass ? 59007.0 : 60.0);
+        test_assert_volume(vol, dims, spacing, want, pass ? 7.0 : 0.0, pass ? 59007.0 : 60.0);
         umbra_volume_release(vol);
         vol = NULL;
     }
@@ -565,7 +540,7 @@ static void test_nifti_types_and_scaling(void **state)
     nim->scl_inter = -1024.0;
     nim_write(nim, tmp_path(path, "ct.nii.gz"));
     assert_int_equal(umbra_volume_load_nifti(ctx, path, &vol), UMBRA_SUCCESS);
-    assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -1024.0, 3176.0);
+    test_assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -1024.0, 3176.0);
     umbra_volume_release(vol);
 
     nim = nim_new(DT_INT8, 2, 2, 2, 1);
@@ -582,7 +557,7 @@ static void test_nifti_types_and_scaling(void **state)
         umbra__nifti_volume_free(&nv);
     }
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
-    assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -70.0, 70.0);
+    test_assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -70.0, 70.0);
     umbra_volume_release(vol);
 
     nim = nim_new(DT_FLOAT64, 2, 2, 2, 1);
@@ -592,7 +567,7 @@ static void test_nifti_types_and_scaling(void **state)
     }
     nim_write(nim, tmp_path(path, "f64.nii"));
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
-    assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, 0.0, (double)(float)0.7);
+    test_assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, 0.0, (double)(float)0.7);
     umbra_volume_release(vol);
 
     nim = nim_new(DT_INT32, 2, 2, 2, 1);
@@ -609,7 +584,7 @@ static void test_nifti_types_and_scaling(void **state)
         nim_write(n4, tmp_path(path, "i32t1.nii"));
     }
     assert_int_equal(umbra_volume_load(ctx, path, &vol), UMBRA_SUCCESS);
-    assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -5.0, 699995.0);
+    test_assert_volume(vol, dims, (const float[3]){1, 1, 1}, want, -5.0, 699995.0);
     umbra_volume_release(vol);
 }
 

@@ -61,31 +61,6 @@ static unsigned char *zlib_pack(const void *data, size_t size, size_t *out_size)
     return z;
 }
 
-/* vol has dims, spacing, range [lo, hi] and voxels (want[i] - lo) / (hi - lo). */
-static void assert_volume(umbra_volume vol, const uint32_t dims[3], const float spacing[3],
-                          const double *want, double lo, double hi)
-{
-    umbra_volume_info info;
-    size_t count = (size_t)dims[0] * dims[1] * dims[2], i;
-    float *vox;
-    assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
-    for (i = 0; i < 3; ++i) {
-        assert_int_equal(info.dims[i], dims[i]);
-        assert_float_equal(info.spacing[i], spacing[i], 1e-6);
-    }
-    assert_float_equal(info.value_min, lo, 1e-3);
-    assert_float_equal(info.value_max, hi, 1e-3);
-    vox = test_read_voxels(vol);
-    for (i = 0; i < count; ++i) {
-        double w = (want[i] - lo) / (hi - lo);
-        if (fabs(vox[i] - w) > 1e-6) {
-            print_message("voxel %zu: %.9g, expected %.9g\n", i, (double)vox[i], w);
-        }
-        assert_float_equal(vox[i], w, 1e-6);
-    }
-    free(vox);
-}
-
 /* Loads path, checks it against dims/spacing/want and releases it. */
 static void load_and_check(umbra_context ctx, const char *path, const uint32_t dims[3],
                            const float spacing[3], const double *want, double lo, double hi)
@@ -96,7 +71,7 @@ static void load_and_check(umbra_context ctx, const char *path, const uint32_t d
         print_message("%s: %s\n", path, umbra_context_last_message(ctx));
     }
     assert_int_equal(st, UMBRA_SUCCESS);
-    assert_volume(vol, dims, spacing, want, lo, hi);
+    test_assert_volume(vol, dims, spacing, want, lo, hi);
     umbra_volume_release(vol);
 }
 

@@ -99,6 +99,30 @@ float *test_read_voxels(umbra_volume vol)
     return out;
 }
 
+void test_assert_volume(umbra_volume vol, const uint32_t dims[3], const float spacing[3],
+                        const double *want, double lo, double hi)
+{
+    umbra_volume_info info;
+    size_t count = (size_t)dims[0] * dims[1] * dims[2], i;
+    float *vox;
+    assert_int_equal(umbra_volume_get_info(vol, &info), UMBRA_SUCCESS);
+    for (i = 0; i < 3; ++i) {
+        assert_int_equal(info.dims[i], dims[i]);
+        assert_float_equal(info.spacing[i], spacing[i], 1e-6);
+    }
+    assert_float_equal(info.value_min, lo, 1e-3);
+    assert_float_equal(info.value_max, hi, 1e-3);
+    vox = test_read_voxels(vol);
+    for (i = 0; i < count; ++i) {
+        double w = (want[i] - lo) / (hi - lo);
+        if (fabs(vox[i] - w) > 1e-6) {
+            print_message("voxel %zu: %.9g, expected %.9g\n", i, (double)vox[i], w);
+        }
+        assert_float_equal(vox[i], w, 1e-6);
+    }
+    free(vox);
+}
+
 const char *test_tmp_path(char *buf, size_t size, const char *name)
 {
     int n = snprintf(buf, size, "%s/%s", test_tmpdir(), name);

@@ -41,6 +41,10 @@ double test_path_in_box(const double p[3], const double dir[3], const double hal
 /* A volume's normalised voxels read back from the device (malloc'ed; the caller frees them). */
 float *test_read_voxels(umbra_volume vol);
 
+/* vol has dims, spacing, value range [lo, hi] and voxels (want[i] - lo) / (hi - lo) to 1e-6. */
+void test_assert_volume(umbra_volume vol, const uint32_t dims[3], const float spacing[3],
+                        const double *want, double lo, double hi);
+
 /* buf (size bytes) = test_tmpdir()/name; fails the test if it does not fit. Returns buf. */
 const char *test_tmp_path(char *buf, size_t size, const char *name);
 /* Writes size bytes (or a string) to path, failing the test on any error. */
