@@ -2,7 +2,8 @@
 /* io/nifti.c: NIfTI-1 and NIfTI-2 volumes through nifticlib (Debian's libnifti2-dev).
  *
  * nifticlib parses the header (either version, byte order, gzip through its znzlib) and reads the
- * voxels; this file decides what umbra accepts: single-file .nii / .nii.gz only, three dimensions
+ * voxels (nifti_read_buffer, straight into the volume's buffer through umbra_volume_create_filled,
+ * or a chunk at a time where they are converted); this file decides what umbra accepts: single-file .nii / .nii.gz only, three dimensions
  * (higher ones of size 1), the type mapping and scl_slope/scl_inter rule documented in
  * umbra/io.h, and the header's claimed size checked against the file before any voxel buffer is
  * allocated. A gzip file's uncompressed size is not known before decompressing it, so there the
