@@ -256,15 +256,20 @@ static int parse_bool(const char *s)
     return -1;
 }
 
-/* Inflates exactly n bytes into dst from in (zlib or gzip framing, detected), which must end the
- * stream exactly there. */
+/* Takes the next bytes of decoded voxels (a whole number of them) from the window they were
+ * decoded into; returns UMBRA_SUCCESS or a status it recorded. */
+typedef umbra_status (*met_sink)(void *user, unsigned char *bytes, size_t n);
+
+/* Inflates exactly n bytes from in (zlib or gzip framing, detected), which must end the stream
+ * exactly there. Without a sink they land in dst (n bytes); with one, dst is a window of win
+ * bytes (a multiple of the voxel size), handed to sink each time it is full and at the end. */
 static umbra_status inflate_exact(umbra_context ctx, const char *func, const char *path,
                                   const unsigned char *in, size_t in_size, unsigned char *dst,
-                                  size_t n)
+                                  size_t n, size_t win, met_sink sink, void *user)
 {
     umbra_status st = UMBRA_SUCCESS;
     z_stream zs;
-    size_t in_done = 0, out_done = 0;
+    size_t in_done = 0, out_done = 0, win_fill = 0;
     int rc = Z_OK;
 
     memset(&zs, 0, sizeof zs);
@@ -274,19 +279,28 @@ static umbra_status inflate_exact(umbra_context ctx, const char *func, const cha
                            path);
     }
     while (rc == Z_OK) {
-        size_t in_left = in_size - in_done, out_left = n - out_done;
+        size_t in_left = in_size - in_done,
+               out_left = sink && win - win_fill < n - out_done ? win - win_fill : n - out_done;
         uInt ai = (uInt)(in_left > UINT_MAX ? UINT_MAX : in_left);
         uInt ao = (uInt)(out_left > UINT_MAX ? UINT_MAX : out_left);
         unsigned char spill;
         zs.next_in = (unsigned char *)(uintptr_t)(in + in_done); /* zlib's API is not const */
         zs.avail_in = ai;
         /* With the output full, one spare byte shows whether the stream goes on. */
-        zs.next_out = ao ? dst + out_done : &spill;
+        zs.next_out = ao ? dst + (sink ? win_fill : out_done) : &spill;
         zs.avail_out = ao ? ao : 1;
         rc = inflate(&zs, Z_NO_FLUSH);
         in_done += ai - zs.avail_in;
         if (ao) {
             out_done += ao - zs.avail_out;
+            win_fill += ao - zs.avail_out;
+            if (sink && (win_fill == win || out_done == n)) {
+                st = sink(user, dst, win_fill);
+                win_fill = 0;
+                if (st != UMBRA_SUCCESS) {
+                    goto done;
+                }
+            }
         } else if (zs.avail_out == 0) {
             st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                              "%s: \"%s\": the compressed data holds more than the %zu bytes the "
@@ -515,6 +529,103 @@ static umbra_status header_interpret(umbra_context ctx, const char *func, const 
     return UMBRA_SUCCESS;
 }
 
+/* Voxels read and converted per step where the file's type is not umbra's (1 MiB of 8-byte
+ * ones). */
+#define CONVERT_CHUNK ((size_t)1 << 17)
+
+/* What the fill callback reads: f (path) from its voxels on, raw or packed_n compressed bytes. */
+typedef struct met_fill {
+    umbra_context ctx;
+    const char *func, *path;
+    FILE *f;
+    int compressed;
+    size_t packed_n;           /* compressed bytes */
+    int type;                  /* index into met_types */
+    size_t count, done;        /* voxels in all and converted so far */
+    int swap;                  /* the file's byte order is not the host's */
+    unsigned char *dst;        /* the fill buffer, of met_types[type].umbra */
+} met_fill;
+
+/* met_sink: swaps and converts the next n bytes of voxels into the fill buffer. */
+static umbra_status met_convert(void *user, unsigned char *bytes, size_t n)
+{
+    met_fill *F = user;
+    size_t in = met_types[F->type].size, k = n / in;
+    if (F->swap) {
+        umbra__swap_bytes(bytes, k, in);
+    }
+    if (!convert(bytes, F->type, k,
+                 F->dst + F->done * umbra_scalar_type_size(met_types[F->type].umbra))) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": a %s voxel is not a finite "
+                           "float32", F->func, F->path, met_types[F->type].name);
+    }
+    F->done += k;
+    return UMBRA_SUCCESS;
+}
+
+/* umbra_volume_fill_fn: decodes the voxels into dst. A type umbra keeps (uchar, short, ushort,
+ * float) is read or inflated into dst itself and swapped there; the others go through a
+ * CONVERT_CHUNK window, so that no second full-size copy of the voxels exists. Compressed data
+ * is held whole while it inflates (its size is the file's). */
+static umbra_status fill_met(void *user, void *dst, size_t bytes)
+{
+    met_fill *F = user;
+    umbra_status st = UMBRA_SUCCESS;
+    size_t in = met_types[F->type].size, data_bytes = F->count * in;
+    int keep = F->type == T_UCHAR || F->type == T_USHORT || F->type == T_SHORT ||
+               F->type == T_FLOAT;
+    unsigned char *packed = NULL, *window = NULL;
+
+    if (bytes != F->count * umbra_scalar_type_size(met_types[F->type].umbra)) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: \"%s\": the fill buffer "
+                           "holds %zu bytes, not %zu voxels of %zu bytes", F->func, F->path,
+                           bytes, F->count, umbra_scalar_type_size(met_types[F->type].umbra));
+    }
+    F->dst = dst;
+    F->done = 0;
+    if (!keep) {
+        window = malloc(CONVERT_CHUNK * in);
+        if (!window) {
+            return umbra__fail(F->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu "
+                               "bytes to convert the voxels of \"%s\"", F->func,
+                               CONVERT_CHUNK * in, F->path);
+        }
+    }
+    if (F->compressed) {
+        packed = malloc(F->packed_n ? F->packed_n : 1);
+        if (!packed) {
+            st = umbra__fail(F->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes "
+                             "for the compressed voxels of \"%s\"", F->func, F->packed_n,
+                             F->path);
+            goto done;
+        }
+        st = umbra__file_read(F->ctx, F->func, F->path, F->f, packed, F->packed_n);
+        if (st == UMBRA_SUCCESS) {
+            st = keep ? inflate_exact(F->ctx, F->func, F->path, packed, F->packed_n, dst,
+                                      data_bytes, 0, NULL, NULL)
+                      : inflate_exact(F->ctx, F->func, F->path, packed, F->packed_n, window,
+                                      data_bytes, CONVERT_CHUNK * in, met_convert, F);
+        }
+    } else if (keep) {
+        st = umbra__file_read(F->ctx, F->func, F->path, F->f, dst, data_bytes);
+    } else {
+        while (st == UMBRA_SUCCESS && F->done < F->count) {
+            size_t k = F->count - F->done < CONVERT_CHUNK ? F->count - F->done : CONVERT_CHUNK;
+            st = umbra__file_read(F->ctx, F->func, F->path, F->f, window, k * in);
+            if (st == UMBRA_SUCCESS) {
+                st = met_convert(F, window, k * in);
+            }
+        }
+    }
+    if (st == UMBRA_SUCCESS && keep && F->swap) {
+        umbra__swap_bytes(dst, F->count, in);
+    }
+done:
+    free(packed);
+    free(window);
+    return st;
+}
+
 umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, umbra_volume *out)
 {
     static const char *const func = "umbra_volume_load_metaimage";
@@ -522,8 +633,6 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
     locale_t c_locale = (locale_t)0;
     FILE *f = NULL, *df = NULL;
     char *text = NULL, *dpath = NULL;
-    unsigned char *packed = NULL;
-    void *raw = NULL, *conv = NULL;
     size_t file_size = 0, head_n, data_size = 0, type_size, data_bytes, start, avail;
     met_header h;
     met_image m;
@@ -660,64 +769,23 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
         avail = packed_n;
     }
 
-    /* Read. */
+    /* Read: straight into the volume's buffer (umbra_volume_create_filled). */
     if (fseeko(df, (off_t)start, SEEK_SET) != 0) {
         char buf[256];
         st = umbra__fail(ctx, UMBRA_ERROR_IO, "%s: cannot seek to byte %zu of \"%s\": %s", func,
                          start, local ? path : dpath, umbra__errno_text(errno, buf, sizeof buf));
         goto fail;
     }
-    raw = malloc(data_bytes);
-    if (!raw) {
-        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes for the "
-                         "voxels of \"%s\"", func, data_bytes, path);
-        goto fail;
+    {
+        met_fill F = {ctx, func, local ? path : dpath, df, m.compressed, avail, m.type,
+                      m.count, 0, type_size > 1 && (m.msb != 0) != umbra__host_is_big_endian(),
+                      NULL};
+        st = umbra__volume_from_fill(ctx, fill_met, &F, met_types[m.type].umbra, m.dims,
+                                     m.spacing, m.placed ? m.origin : NULL,
+                                     m.placed ? m.dirs : NULL, out);
     }
-    if (m.compressed) {
-        packed = malloc(avail ? avail : 1);
-        if (!packed) {
-            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes for "
-                             "the compressed voxels of \"%s\"", func, avail, path);
-            goto fail;
-        }
-        st = umbra__file_read(ctx, func, local ? path : dpath, df, packed, avail);
-        if (st == UMBRA_SUCCESS) {
-            st = inflate_exact(ctx, func, local ? path : dpath, packed, avail, raw, data_bytes);
-        }
-        free(packed);
-        packed = NULL;
-    } else {
-        st = umbra__file_read(ctx, func, local ? path : dpath, df, raw, data_bytes);
-    }
-    if (st != UMBRA_SUCCESS) {
-        goto fail;
-    }
-    if (type_size > 1 && (m.msb != 0) != umbra__host_is_big_endian()) {
-        umbra__swap_bytes(raw, m.count, type_size);
-    }
-    if (m.type != T_UCHAR && m.type != T_USHORT && m.type != T_SHORT && m.type != T_FLOAT) {
-        conv = malloc(m.count * umbra_scalar_type_size(met_types[m.type].umbra));
-        if (!conv) {
-            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu converted "
-                             "voxels for \"%s\"", func, m.count, path);
-            goto fail;
-        }
-        if (!convert(raw, m.type, m.count, conv)) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": a %s voxel is not a finite "
-                             "float32", func, path, met_types[m.type].name);
-            goto fail;
-        }
-        free(raw);
-        raw = conv;
-        conv = NULL;
-    }
-    st = umbra__volume_from_host(ctx, raw, met_types[m.type].umbra, m.dims, m.spacing,
-                                 m.placed ? m.origin : NULL, m.placed ? m.dirs : NULL, out);
 
 fail:
-    free(conv);
-    free(raw);
-    free(packed);
     free(dpath);
     free(text);
     if (df) {

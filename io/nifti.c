@@ -2,7 +2,8 @@
 /* io/nifti.c: NIfTI-1 and NIfTI-2 volumes through nifticlib (Debian's libnifti2-dev).
  *
  * nifticlib parses the header (either version, byte order, gzip through its znzlib) and reads the
- * voxels; this file decides what umbra accepts: single-file .nii / .nii.gz only, three dimensions
+ * voxels (nifti_read_buffer, straight into the volume's buffer through umbra_volume_create_filled,
+ * or a chunk at a time where they are converted); this file decides what umbra accepts: single-file .nii / .nii.gz only, three dimensions
  * (higher ones of size 1), the type mapping and scl_slope/scl_inter rule documented in
  * umbra/io.h, and the header's claimed size checked against the file before any voxel buffer is
  * allocated. A gzip file's uncompressed size is not known before decompressing it, so there the
@@ -99,19 +100,33 @@ static int is_gzip(const char *path)
     return got == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
 }
 
-umbra_status umbra__nifti_read(umbra_context ctx, const char *func, const char *path,
-                               umbra__nifti_volume *out)
+/* What the fill callback reads: the header nifticlib parsed and what was decided from it. */
+typedef struct nifti_fill {
+    umbra_context ctx;
+    const char *func, *path;
+    nifti_image *nim;
+    size_t count, data_bytes;
+    umbra_scalar_type type;
+    int scale;
+    double slope, inter;
+} nifti_fill;
+
+/* Reads and checks path's header into *out (everything but the voxels) and *F. On failure
+ * nothing is left to free; on success F->nim is the caller's to nifti_image_free. */
+static umbra_status nifti_header(umbra_context ctx, const char *func, const char *path,
+                                 umbra__nifti_volume *out, nifti_fill *F)
 {
     umbra_status st = UMBRA_SUCCESS;
     nifti_image *nim = NULL;
     struct stat sb;
     size_t count = 1, data_bytes, i;
     umbra_scalar_type type;
-    int gz, scale, keep, loaded, r, c;
+    int gz, scale, r, c;
     double slope, inter;
     char ebuf[256];
 
     memset(out, 0, sizeof *out);
+    memset(F, 0, sizeof *F);
     if (!path) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", func);
     }
@@ -287,50 +302,132 @@ umbra_status umbra__nifti_read(umbra_context ctx, const char *func, const char *
     out->slope = slope;
     out->inter = inter;
 
-    pthread_mutex_lock(&nifti_lock);
-    nifti_set_debug_level(0);
-    loaded = nifti_image_load(nim);
-    nifti_set_debug_level(NIFTI_DEFAULT_DEBUG);
-    pthread_mutex_unlock(&nifti_lock);
-    if (loaded != 0 || !nim->data) {
-        st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                         "%s: \"%s\": cannot read its %zu bytes of voxels (truncated or corrupt "
-                         "data)",
-                         func, path, data_bytes);
-        goto fail;
-    }
-    keep = !scale && ((nim->datatype == DT_UINT8 && type == UMBRA_UINT8) ||
-                      (nim->datatype == DT_UINT16 && type == UMBRA_UINT16) ||
-                      (nim->datatype == DT_INT16 && type == UMBRA_INT16) ||
-                      (nim->datatype == DT_FLOAT32 && type == UMBRA_FLOAT32));
-    if (keep) {
-        /* Take nifticlib's buffer as it is. */
-        out->voxels = nim->data;
-        nim->data = NULL;
-    } else {
-        out->voxels = malloc(count * umbra_scalar_type_size(type));
-        if (!out->voxels) {
-            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                             "%s: cannot allocate %zu converted voxels for \"%s\"", func, count,
-                             path);
-            goto fail;
-        }
-        if (!convert(nim->data, nim->datatype, count, scale, slope, inter, type, out->voxels)) {
-            st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                             "%s: \"%s\": a voxel (%s, times scl_slope %g plus scl_inter %g) is "
-                             "not a finite float32",
-                             func, path, nifti_datatype_string(nim->datatype), slope, inter);
-            goto fail;
-        }
-    }
     out->type = type;
-    nifti_image_free(nim);
+    F->ctx = ctx;
+    F->func = func;
+    F->path = path;
+    F->nim = nim;
+    F->count = count;
+    F->data_bytes = data_bytes;
+    F->type = type;
+    F->scale = scale;
+    F->slope = slope;
+    F->inter = inter;
     return UMBRA_SUCCESS;
 
 fail:
-    umbra__nifti_volume_free(out);
     if (nim) {
         nifti_image_free(nim);
+    }
+    return st;
+}
+
+/* Voxels converted per step: 1 MiB of the widest NIfTI type umbra reads. */
+#define CONVERT_CHUNK ((size_t)1 << 17)
+
+/* umbra_volume_fill_fn: reads the voxels at vox_offset (through znzlib, so .nii.gz too) into dst,
+ * which holds F->count voxels of F->type. nifticlib's nifti_read_buffer swaps the bytes and
+ * zeroes non-finite floats as nifti_image_load did. A file type umbra keeps as it is lands in
+ * dst directly; one converted (scl_slope, int8, 32- and 64-bit types) is read a chunk at a time
+ * and converted into dst, so no second full-size copy exists. */
+static umbra_status fill_nifti(void *user, void *dst, size_t bytes)
+{
+    nifti_fill *F = user;
+    nifti_image *nim = F->nim;
+    enum { OK, NO_OPEN, SHORT, NOT_FINITE } why = OK; /* reported after the unlock */
+    size_t out_size = umbra_scalar_type_size(F->type), done = 0, in_size = (size_t)nim->nbyper;
+    unsigned char *chunk = NULL;
+    znzFile fp = NULL;
+    int keep = !F->scale && ((nim->datatype == DT_UINT8 && F->type == UMBRA_UINT8) ||
+                             (nim->datatype == DT_UINT16 && F->type == UMBRA_UINT16) ||
+                             (nim->datatype == DT_INT16 && F->type == UMBRA_INT16) ||
+                             (nim->datatype == DT_FLOAT32 && F->type == UMBRA_FLOAT32));
+
+    if (bytes != F->count * out_size) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: \"%s\": the fill buffer holds %zu bytes, not the %zu of %zu voxels",
+                           F->func, F->path, bytes, F->count * out_size, F->count);
+    }
+    if (!keep) {
+        chunk = malloc(CONVERT_CHUNK * in_size);
+        if (!chunk) {
+            return umbra__fail(F->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                               "%s: cannot allocate %zu bytes to convert the voxels of \"%s\"",
+                               F->func, CONVERT_CHUNK * in_size, F->path);
+        }
+    }
+    /* Every nifticlib call under the lock with its printing off, as in nifti_header. */
+    pthread_mutex_lock(&nifti_lock);
+    nifti_set_debug_level(0);
+    fp = znzopen(nim->iname, "rb", nifti_is_gzfile(nim->iname));
+    if (znz_isnull(fp)) {
+        why = NO_OPEN;
+    } else if (znzseek(fp, (znz_off_t)nim->iname_offset, SEEK_SET) < 0) {
+        why = SHORT; /* gzseek gives the new offset, fseek 0: only -1 is a failure */
+    } else if (keep) {
+        if (nifti_read_buffer(fp, dst, (int64_t)F->data_bytes, nim) != (int64_t)F->data_bytes)
+            why = SHORT;
+    } else {
+        while (done < F->count) {
+            size_t n = F->count - done < CONVERT_CHUNK ? F->count - done : CONVERT_CHUNK;
+            if (nifti_read_buffer(fp, chunk, (int64_t)(n * in_size), nim) !=
+                (int64_t)(n * in_size)) {
+                why = SHORT;
+                break;
+            }
+            if (!convert(chunk, nim->datatype, n, F->scale, F->slope, F->inter, F->type,
+                         (unsigned char *)dst + done * out_size)) {
+                why = NOT_FINITE;
+                break;
+            }
+            done += n;
+        }
+    }
+    if (!znz_isnull(fp)) {
+        znzclose(fp);
+    }
+    nifti_set_debug_level(NIFTI_DEFAULT_DEBUG);
+    pthread_mutex_unlock(&nifti_lock);
+    free(chunk);
+
+    if (why == NO_OPEN) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_IO, "%s: cannot open \"%s\" to read its voxels",
+                           F->func, F->path);
+    }
+    if (why == SHORT) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_FORMAT,
+                           "%s: \"%s\": cannot read its %zu bytes of voxels (truncated or corrupt "
+                           "data)",
+                           F->func, F->path, F->data_bytes);
+    }
+    if (why == NOT_FINITE) {
+        return umbra__fail(F->ctx, UMBRA_ERROR_FORMAT,
+                           "%s: \"%s\": a voxel (%s, times scl_slope %g plus scl_inter %g) is "
+                           "not a finite float32",
+                           F->func, F->path, nifti_datatype_string(nim->datatype), F->slope,
+                           F->inter);
+    }
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__nifti_read(umbra_context ctx, const char *func, const char *path,
+                               umbra__nifti_volume *out)
+{
+    nifti_fill F;
+    umbra_status st = nifti_header(ctx, func, path, out, &F);
+    if (st != UMBRA_SUCCESS) {
+        return st;
+    }
+    out->voxels = malloc(F.count * umbra_scalar_type_size(F.type));
+    if (!out->voxels) {
+        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                         "%s: cannot allocate %zu voxels for \"%s\"", func, F.count, path);
+    } else {
+        st = fill_nifti(&F, out->voxels, F.count * umbra_scalar_type_size(F.type));
+    }
+    nifti_image_free(F.nim);
+    if (st != UMBRA_SUCCESS) {
+        umbra__nifti_volume_free(out);
     }
     return st;
 }
@@ -338,7 +435,8 @@ fail:
 umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path, umbra_volume *out)
 {
     umbra__nifti_volume nv;
-    umbra_volume_desc vd;
+    nifti_fill F;
+    float origin[3], directions[9];
     umbra_status st;
 
     if (!out) {
@@ -348,27 +446,22 @@ umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path, umbra_
     if (!ctx) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
     }
-    st = umbra__nifti_read(ctx, __func__, path, &nv);
+    st = nifti_header(ctx, __func__, path, &nv, &F);
     if (st != UMBRA_SUCCESS) {
         return st;
     }
-    umbra_volume_desc_init(&vd);
-    vd.data = nv.voxels;
-    vd.type = nv.type;
-    memcpy(vd.dims, nv.dims, sizeof vd.dims);
-    memcpy(vd.spacing, nv.spacing, sizeof vd.spacing);
     /* The file's world (RAS+ by NIfTI's convention) becomes the volume's: origin = the last
      * column, index axis a's direction = column a over its length. A header with neither sform
      * nor qform places nothing, and the box stays centred. */
-    if (nv.transform != UMBRA__NIFTI_PIXDIM) {
-        vd.transform_given = 1;
-        for (int r = 0; r < 3; ++r) {
-            vd.origin[r] = (float)nv.index_to_world[r][3];
-            for (int a = 0; a < 3; ++a)
-                vd.directions[3 * a + r] = (float)(nv.index_to_world[r][a] / nv.spacing[a]);
-        }
+    for (int r = 0; r < 3; ++r) {
+        origin[r] = (float)nv.index_to_world[r][3];
+        for (int a = 0; a < 3; ++a)
+            directions[3 * a + r] = (float)(nv.index_to_world[r][a] / nv.spacing[a]);
     }
-    st = umbra_volume_create(ctx, &vd, out);
-    umbra__nifti_volume_free(&nv);
+    /* The voxels go straight into the volume's buffer (umbra_volume_create_filled). */
+    st = umbra__volume_from_fill(ctx, fill_nifti, &F, nv.type, nv.dims, nv.spacing,
+                                 nv.transform != UMBRA__NIFTI_PIXDIM ? origin : NULL,
+                                 nv.transform != UMBRA__NIFTI_PIXDIM ? directions : NULL, out);
+    nifti_image_free(F.nim);
     return st;
 }

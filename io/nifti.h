@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 /* io/nifti.h: the NIfTI reader's host-side result, shared by io/nifti.c and the tests.
  *
- * umbra_volume_load_nifti hands the voxels to umbra_volume_create; this structure also keeps what
- * the volume cannot hold yet, the file's index-to-world matrix, so that it can be passed on when
- * volumes carry a world transform. */
+ * umbra_volume_load_nifti reads the voxels straight into the volume's buffer; umbra__nifti_read
+ * (the tests') reads them into host memory, and this structure also keeps the file's
+ * index-to-world matrix, how it was chosen and the scaling applied. */
 #ifndef UMBRA_IO_NIFTI_H
 #define UMBRA_IO_NIFTI_H
 
