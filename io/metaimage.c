@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* io/metaimage.c: MetaImage volumes (.mha with the voxels in the same file, .mhd with them in a
- * separate raw or zlib-compressed file), as ITK, 3D Slicer and VTK write them.
+ * separate raw or zlib-compressed file), as ITK, 3D Slicer and VTK write them. One file past 800
+ * lines: the header reader, the data reader and the fill into the volume's buffer share one
+ * parsed header struct and its checks, and nothing else in umbra_io uses them.
  *
  * Why umbra reads MetaImage itself. The one MetaImage library Debian 12 ships is MetaIO, inside
  * ITK (libITKMetaIO-5.2, in libinsighttoolkit5-dev, 33 packages) and again inside VTK

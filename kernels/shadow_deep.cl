@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* kernels/shadow_deep.cl: deep shadow maps for volume ray casting (Hadwiger, Kratz, Sigg and
- * Buehler 2006, after Lokovic and Veach 2000). Three build stages, compiled (DEEP_BUILD_KERNELS=1)
- * into the build program of host/shadow_deep.c:
+ * Buehler 2006, after Lokovic and Veach 2000). One file past 800 lines, because an OpenCL program
+ * is built from one source here and the three stages share the texel's march and compression.
+ * Three build stages, compiled (DEEP_BUILD_KERNELS=1) into the build program of host/shadow_deep.c:
  *
  *   deep_lut          the pre-compressed segment table: for every pair of successive quantised
  *                     light-ray samples (s_f, s_b) the visibility of the segment between them,
