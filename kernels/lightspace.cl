@@ -115,6 +115,21 @@ inline bool ls_base_texel(__global const UmbraShadow *S, float2 xy, int2 *texel)
     return true;
 }
 
+/* How far the taps reach from the sample's texel along x or y (the largest |offset| above). */
+#define LS_TAP_REACH 10
+
+/* Whether every tap around texel t lies inside the map, so that tap j is simply at
+ * t's index + ls_tap_offset(n, j), with no folding or bounds check: the lookups take this path
+ * for all but the samples within LS_TAP_REACH texels of the map's edge, and it reads the same
+ * texels as ls_texel_index would (the per-tap checks were most of a lookup's work, issue #12). */
+inline bool ls_taps_inside(int n, int2 t)
+{
+    return t.x >= LS_TAP_REACH && t.y >= LS_TAP_REACH && t.x < n - LS_TAP_REACH &&
+           t.y < n - LS_TAP_REACH;
+}
+
+inline int ls_tap_offset(int n, uint j) { return ls_taps[j].y * n + ls_taps[j].x; }
+
 /* Index of texel t in the map, or -1 outside it. An octahedral map covers every direction and its
  * border folds onto itself (the octahedron's lower faces meet there), so a tap that crosses the
  * border continues mirrored on the other side of the edge's midpoint; elsewhere outside is -1. */

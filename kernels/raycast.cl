@@ -51,14 +51,23 @@ inline void shade_ray_light(__global const UmbraFrame *F, float3 d, float3 *l, f
 
 /* The mean depth of the emission along a segment of opacity a, in units of its length, from its
  * front: the emission density is sigma exp(-sigma s) at depth s, whose mean is
- * 1/tau - (1 - a)/a, tau = -ln(1 - a): one half for a thin segment, 0 for an opaque one. */
+ * 1/tau - (1 - a)/a, tau = -ln(1 - a): one half for a thin segment, 0 for an opaque one.
+ * It only places where a sample's light is looked up within its step, so it is evaluated
+ * approximately, without branches or calls (the exact form's log1p, two divisions and series
+ * branch for small a are taken at every visible sample, issue #12): u = -log2(1 - a)
+ * from 1 - a's exponent and a quadratic in its mantissa, then a rational function of u fitted to
+ * the mean over u in [0, 24], which holds every float a < 1. Within 4.7e-4 of the exact mean for
+ * every float a in [0, 1] (with or without fused multiply-adds); 1/2 at a = 0, 0 at a = 1.
+ * tests/reference/cpu_reference.c (cpu_emission_depth) evaluates the same expression and
+ * tests/test_emission_depth.c bounds it. */
 inline float emission_depth(float a)
 {
-    if (!(a < 1.0f))
-        return 0.0f;
-    if (a < 1e-3f)
-        return 0.5f + log1p(-a) / 12.0f; /* the series 1/2 - tau/12: 1/tau - (1-a)/a cancels */
-    return -1.0f / log1p(-a) - (1.0f - a) / a;
+    const uint b = as_uint(1.0f - a);
+    const float f = as_float((b & 0x007fffffu) | 0x3f800000u) - 1.0f; /* mantissa - 1 */
+    const float u = (float)(127 - (int)(b >> 23)) - f * (1.35457563f - 0.35457563f * f);
+    const float m = (0.5f + u * (0.0153764998f + u * 0.00439499835f)) /
+                    (1.0f + u * (0.147417943f + u * (0.0241450484f + u * 0.00272645837f)));
+    return select(0.0f, m, a < 1.0f); /* a = 1: u = 127, and the mean is 0 */
 }
 
 /* Where a plain sample at p (opacity a, step h along d) takes its light. A thin sample stands for

@@ -111,7 +111,15 @@ inline float3 cssm_lookup(__global const UmbraShadow *S, __global const float *m
         return (float3)(1.0f);
     const uint taps = S->taps;
     const float s = m.z - S->depth_bias;
+    const int n = (int)S->map_size;
     light_t lit = (light_t)(0.0f);
+    if (ls_taps_inside(n, base)) {
+        const int i0 = base.y * n + base.x;
+        for (uint j = 0; j < taps; ++j)
+            lit += select((light_t)(0.0f), (light_t)(1.0f),
+                          CSSM_LOAD(i0 + ls_tap_offset(n, j), map) > (light_t)(s));
+        return light_rgb(lit / (float)taps);
+    }
     for (uint j = 0; j < taps; ++j) {
         const int i = ls_texel_index(S, base + ls_taps[j]);
         if (i < 0)

@@ -87,7 +87,14 @@ inline float threshold_lookup(__global const UmbraShadow *S, __global const floa
         return 1.0f;
     const uint taps = S->taps;
     const float s = m.z - S->depth_bias;
+    const int n = (int)S->map_size;
     float lit = 0.0f;
+    if (ls_taps_inside(n, base)) {
+        __global const float *c = map + (base.y * n + base.x);
+        for (uint j = 0; j < taps; ++j)
+            lit += !(s > c[ls_tap_offset(n, j)]) ? 1.0f : 0.0f;
+        return lit / (float)taps;
+    }
     for (uint j = 0; j < taps; ++j) {
         const int i = ls_texel_index(S, base + ls_taps[j]);
         lit += (i < 0 || !(s > map[i])) ? 1.0f : 0.0f;

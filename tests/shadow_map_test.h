@@ -11,7 +11,10 @@
  *    map's size;
  *  - empty-space skipping of the light rays (the walk over the light's cell masks) changes no
  *    pixel, for the scene's directional light and a point light;
- *  - the image on the spheres scene stays within a stated mean error of the exact reference. */
+ *  - the image on the spheres scene stays within a stated mean error of the exact reference;
+ *  - a filtered lookup is the mean of one-tap lookups at its taps' texels, over every texel of a
+ *    small map and a rim around it, so that the lookups' two paths (all taps inside the map,
+ *    and taps checked one by one near and beyond its edge) read the texels they should. */
 #ifndef UMBRA_TESTS_SHADOW_MAP_TEST_H
 #define UMBRA_TESTS_SHADOW_MAP_TEST_H
 
@@ -59,6 +62,98 @@ static inline void mt_texel_point(umbra_renderer r, uint32_t i, uint32_t j, floa
     float b = S->ls_window[1] + ((float)j + 0.5f) / (n * S->ls_window[3]);
     for (int k = 0; k < 3; ++k)
         p[k] = a * S->ls_u[k] + b * S->ls_v[k] + along * S->ls_w[k];
+}
+
+/* The tap offsets of kernels/lightspace.cl (ls_taps), the first `taps` of them for each set. */
+static const int mt_taps[21][2] = {{0, 0},   {4, 0},   {-4, 0}, {0, 4},  {0, -4},  {3, 3},  {-3, -3},
+                                   {3, -3},  {-3, 3},  {7, 0},  {-7, 0}, {0, 7},   {0, -7}, {5, 5},
+                                   {-5, -5}, {5, -5},  {-5, 5}, {10, 0}, {-10, 0}, {0, 10}, {0, -10}};
+
+/* A filtered lookup at a texel's centre equals the mean of one-tap lookups at the centres of the
+ * texels its taps read (outside the map: lit), for 13 and 21 taps, on a 64^2 map of a lumpy
+ * volume under an oblique light, at every texel of the map and of a rim of 12 texels around it,
+ * at three depths. */
+static inline void mt_check_taps_read_their_texels(umbra_context ctx,
+                                                   umbra_shadow_technique technique)
+{
+    enum { N = 24, MAP = 64, RIM = 12, SIDE = MAP + 2 * RIM, DEPTHS = 3 };
+    float *data = malloc((size_t)N * N * N * sizeof *data);
+    assert_non_null(data);
+    for (int z = 0; z < N; ++z)
+        for (int y = 0; y < N; ++y)
+            for (int x = 0; x < N; ++x)
+                data[(z * N + y) * N + x] =
+                    0.5f + 0.5f * sinf(0.9f * (float)x) * cosf(0.7f * (float)y + 0.5f * (float)z);
+    umbra_volume vol = test_volume(ctx, N, N, N, data);
+    free(data);
+    const float rgba[8] = {0, 0, 0, 0, 0.8f, 0.6f, 0.4f, 0.5f};
+    umbra_transfer_function tf = NULL;
+    assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
+    umbra_renderer r = test_renderer_transmission(ctx, vol, tf, test_directional_light(0.3f, -1, 0.2f),
+                                                  UMBRA_TRANSMISSION_GREY);
+    const size_t count = (size_t)SIDE * SIDE * DEPTHS;
+    float *p = malloc(count * 3 * sizeof *p), *f = malloc(count * 3 * sizeof *f);
+    float *one = malloc(count * 3 * sizeof *one);
+    assert_non_null(p);
+    assert_non_null(f);
+    assert_non_null(one);
+    for (uint32_t taps = 13; taps <= 21; taps += 8) {
+        umbra_shadow_desc s = mt_shadow(technique, MAP, taps);
+        assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
+        const float probe[3] = {0, 0, 0}; /* builds the map, so that its window is known */
+        float pf[3];
+        assert_int_equal(umbra_renderer_query_shadow(r, probe, 1, pf), UMBRA_SUCCESS);
+        const UmbraShadow *S = &r->shadow_params;
+        assert_int_equal(S->ls_mode, UMBRA_LS_ORTHO);
+        assert_int_equal(S->map_size, MAP);
+        /* Texel (i, j)'s centre at `along` (mt_texel_point, here for texels off the map too). */
+#define MT_POINT(dst, i, j, along)                                                                 \
+    do {                                                                                           \
+        float a_ = S->ls_window[0] + ((float)(i) + 0.5f) / ((float)MAP * S->ls_window[2]);         \
+        float b_ = S->ls_window[1] + ((float)(j) + 0.5f) / ((float)MAP * S->ls_window[3]);         \
+        for (int k_ = 0; k_ < 3; ++k_)                                                             \
+            (dst)[k_] = a_ * S->ls_u[k_] + b_ * S->ls_v[k_] + (along) * S->ls_w[k_];               \
+    } while (0)
+        const float along[DEPTHS] = {-6.0f, 0.0f, 5.0f};
+        size_t q = 0;
+        for (int d = 0; d < DEPTHS; ++d)
+            for (int j = -RIM; j < MAP + RIM; ++j)
+                for (int i = -RIM; i < MAP + RIM; ++i, ++q)
+                    MT_POINT(p + 3 * q, i, j, along[d]);
+        assert_int_equal(umbra_renderer_query_shadow(r, p, count, f), UMBRA_SUCCESS);
+        double *sum = calloc(count * 3, sizeof *sum);
+        assert_non_null(sum);
+        s.taps = 1;
+        assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
+        for (uint32_t t = 0; t < taps; ++t) {
+            q = 0;
+            for (int d = 0; d < DEPTHS; ++d)
+                for (int j = -RIM; j < MAP + RIM; ++j)
+                    for (int i = -RIM; i < MAP + RIM; ++i, ++q)
+                        MT_POINT(p + 3 * q, i + mt_taps[t][0], j + mt_taps[t][1], along[d]);
+            assert_int_equal(umbra_renderer_query_shadow(r, p, count, one), UMBRA_SUCCESS);
+            for (size_t k = 0; k < count * 3; ++k)
+                sum[k] += one[k];
+        }
+#undef MT_POINT
+        size_t differ = 0, partial = 0;
+        for (size_t k = 0; k < count * 3; ++k) {
+            const double expect = sum[k] / taps;
+            differ += !(fabs((double)f[k] - expect) <= 1e-6);
+            partial += expect > 0.0 && expect < 1.0;
+        }
+        printf("%u taps: %zu of %zu factors differ from the mean of their taps, %zu partly lit\n",
+               taps, differ, count * 3, partial);
+        assert_true(partial > count / 10); /* the check sees the taps disagree */
+        assert_int_equal(differ, 0);
+        free(sum);
+    }
+    free(one);
+    free(f);
+    free(p);
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(vol);
 }
 
 static inline int mt_finite_unit(const float *v, size_t n)

@@ -232,6 +232,12 @@ static void test_cssm_camera_move_reuses_map(void **state)
     mt_check_reuse_and_memory(ctx, mt_shadow(UMBRA_SHADOW_CSSM, 128, 13), 3, 1);
 }
 
+static void test_cssm_taps_read_their_texels(void **state)
+{
+    (void)state;
+    mt_check_taps_read_their_texels(ctx, UMBRA_SHADOW_CSSM);
+}
+
 /* Measured on PoCL (spheres 48^3, its light, 96x96, map 256^2, step 0.5, seed 1; seeds 2-4
  * within 0.0001): 1 tap 0.0193, 7 taps 0.0076, 13 taps 0.0062, 21 taps 0.0056; no shadows at all
  * is 0.0252 away, the threshold map 0.030 (13 taps). The error left is noise (1 tap) and the
@@ -289,6 +295,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_cssm_stress_lights_finite_and_lit),
         cmocka_unit_test(test_cssm_camera_move_reuses_map),
         cmocka_unit_test(test_cssm_skipping_changes_nothing),
+        cmocka_unit_test(test_cssm_taps_read_their_texels),
         cmocka_unit_test(test_cssm_error_vs_reference_bounded),
         cmocka_unit_test(test_cssm_invalid_parameters_rejected),
     };

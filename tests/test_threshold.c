@@ -176,6 +176,12 @@ static void test_threshold_camera_move_reuses_map(void **state)
     mt_check_reuse_and_memory(ctx, mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 7), 1, 1);
 }
 
+static void test_threshold_taps_read_their_texels(void **state)
+{
+    (void)state;
+    mt_check_taps_read_their_texels(ctx, UMBRA_SHADOW_THRESHOLD);
+}
+
 /* Measured on PoCL (spheres 48^3, its light, 96x96, map 256^2, step 0.5): 1 tap 0.0357, 7 taps
  * 0.0313, 13 taps 0.0300, 21 taps 0.0282; no shadows at all ("none") is 0.0252 away. The hard
  * threshold turns the translucent spheres' partial shadows into full ones, so it is further from
@@ -235,6 +241,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_threshold_stress_lights_finite_and_lit),
         cmocka_unit_test(test_threshold_camera_move_reuses_map),
         cmocka_unit_test(test_threshold_skipping_changes_nothing),
+        cmocka_unit_test(test_threshold_taps_read_their_texels),
         cmocka_unit_test(test_threshold_error_vs_reference_bounded),
         cmocka_unit_test(test_threshold_invalid_parameters_rejected),
     };

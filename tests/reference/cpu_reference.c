@@ -704,6 +704,23 @@ static v3 gradient(const prep *P, v3 p)
     return vmul(mul(mk(g[0], g[1], g[2]), 0.5f), P->inv_spacing);
 }
 
+/* The mean emission depth of a segment of opacity a as the kernel evaluates it
+ * (kernels/raycast.cl, emission_depth): the same expression, operation for operation. */
+float cpu_emission_depth(float a)
+{
+    const float x = 1.0f - a;
+    uint32_t b;
+    memcpy(&b, &x, sizeof b);
+    const uint32_t mb = (b & 0x007fffffu) | 0x3f800000u;
+    float f;
+    memcpy(&f, &mb, sizeof f);
+    f -= 1.0f; /* mantissa - 1 */
+    const float u = (float)(127 - (int32_t)(b >> 23)) - f * (1.35457563f - 0.35457563f * f);
+    const float m = (0.5f + u * (0.0153764998f + u * 0.00439499835f)) /
+                    (1.0f + u * (0.147417943f + u * (0.0241450484f + u * 0.00272645837f)));
+    return a < 1.0f ? m : 0.0f;
+}
+
 static uint32_t hash(uint32_t x)
 {
     x ^= x >> 16;
@@ -803,13 +820,7 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                      * there is a shadow to look up, as the kernel compiled without one does. */
                     v3 sf = mk(1, 1, 1);
                     if (P->s->shadow == UMBRA_SHADOW_REFERENCE) {
-                        float a = c[3], m;
-                        if (!(a < 1.0f))
-                            m = 0.0f;
-                        else if (a < 1e-3f)
-                            m = 0.5f + log1pf(-a) / 12.0f;
-                        else
-                            m = -1.0f / log1pf(-a) - (1.0f - a) / a;
+                        float a = c[3], m = cpu_emission_depth(a);
                         sf = shadow(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
                     }
                     v3 light = vmul(from(s->light.color), sf);
