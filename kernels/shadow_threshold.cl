@@ -14,7 +14,9 @@
  * skipped. Within the
  * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
  * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
- * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. */
+ * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. The march keeps
+ * the optical depth tau = -ln(1 - A) instead of A (the same test and crossing, without an
+ * exponential per segment). */
 
 #define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
 
@@ -47,7 +49,11 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
         const float len = tb.y - tb.x;
         const int n_full = (int)floor(len / h);
         const float last = len - (float)n_full * h;
-        float A = 0.0f;
+        /* The march sums optical depth: the accumulated opacity 1 - exp(-tau) passes the
+         * threshold where tau passes -ln(1 - threshold), so a segment costs one logarithm (its
+         * extinction) and no exponential, and a transparent one none. */
+        const float tau_thr = -log1p(-thr);
+        float tau = 0.0f;
         CellWalk w = walk_begin(g, o, d, tb.x);
         float t_cell = -UMBRA_INF;
         /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. Whole
@@ -62,16 +68,17 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
             const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-            /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
-             * alpha over seg / h steps of h_vox voxels) and its opacity. */
-            const float od = tf_extinction(c.w) * h_vox * (seg / h);
-            const float a = -expm1(-od);
-            if (A + (1.0f - A) * a > thr) {
-                const float frac = -log((1.0f - thr) / (1.0f - A)) / od;
-                depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
-                break;
+            if (c.w > 0.0f) {
+                /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
+                 * alpha over seg / h steps of h_vox voxels). */
+                const float od = tf_extinction(c.w) * h_vox * (seg / h);
+                if (tau + od > tau_thr) {
+                    const float frac = (tau_thr - tau) / od;
+                    depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
+                    break;
+                }
+                tau += od;
             }
-            A += (1.0f - A) * a;
             ++k;
         }
     }
