@@ -85,12 +85,21 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
             /* A transparent sample (alpha 0, common in visible cells) stops no photon: rho = 0
              * is never > r, so its logarithms and random number are skipped. */
-            if (col.w > 0.0f) {
-                const light_t od = light_depth(col, h_vox * (seg / h), flags);
+            const float r = col.w > 0.0f ? umbra_random(seed, (uint)x, (uint)y, (uint)k) : 1.0f;
+            /* Most segments of a translucent medium stop no photon, and that is decided without
+             * a logarithm: od = -ln(1 - a) len m (m the largest absorbed fraction) is at most
+             * a / (1 - a) len m, and -ln(1 - r) at least r, so a bound below r (by a margin of
+             * 1e-4 relative, far beyond the float rounding of either side) means od < -ln(1 - r)
+             * in every channel: the same miss the exact test below finds. */
+            const float a_max = fmin(col.w, UMBRA_ALPHA_MAX);
+            const float len_vox = h_vox * (seg / h);
+            if (col.w > 0.0f &&
+                !(a_max / (1.0f - a_max) * len_vox * light_max(light_absorbed(col, flags)) *
+                      1.0001f < r)) {
+                const light_t od = light_depth(col, len_vox, flags);
                 /* rho > r, i.e. 1 - exp(-od) > r, compared as od > -ln(1 - r): one logarithm
                  * per segment instead of an exponential per channel (the two sides differ only
                  * where rounding puts r within an ulp of rho, a measure-zero change). */
-                const float r = umbra_random(seed, (uint)x, (uint)y, (uint)k);
                 const float r_od = -log1p(-r);
                 c = select(c, fmin(c, (light_t)(ls_depth(S, o, t_mid))), CSSM_HIT(od, r_od));
                 if (CSSM_ALL_SET(c))

@@ -14,7 +14,9 @@
  * skipped. Within the
  * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
  * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
- * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. */
+ * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. The march keeps
+ * the optical depth tau = -ln(1 - A) instead of A (the same test and crossing, without an
+ * exponential per segment). */
 
 #define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
 
@@ -47,7 +49,18 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
         const float len = tb.y - tb.x;
         const int n_full = (int)floor(len / h);
         const float last = len - (float)n_full * h;
-        float A = 0.0f;
+        /* The accumulated opacity 1 - exp(-tau) passes the threshold where the optical depth
+         * tau passes -ln(1 - threshold). A whole segment's depth is h_vox (-ln(1 - a)), so
+         * over whole segments tau = -h_vox ln P with P the product of their 1 - a: the march
+         * keeps P, a multiplication per segment (no logarithm, no exponential), and tests
+         * P (1 - a) < p_thr = exp(-tau_thr / h_vox). tau itself is taken only at the crossing
+         * and at the partial last segment. The product and the sum of logarithms differ by
+         * rounding (about 3e-8 of depth per segment); where the threshold needs p_thr below
+         * 1e-30 (a tiny step and a threshold near 1) the float product would underflow, and
+         * the march sums the logarithms instead. */
+        const float tau_thr = -log1p(-thr), p_thr = exp(-tau_thr / h_vox);
+        const int product = p_thr > 1e-30f;
+        float tau = 0.0f, P = 1.0f;
         CellWalk w = walk_begin(g, o, d, tb.x);
         float t_cell = -UMBRA_INF;
         /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. Whole
@@ -62,16 +75,27 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
             const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
-            /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
-             * alpha over seg / h steps of h_vox voxels) and its opacity. */
-            const float od = tf_extinction(c.w) * h_vox * (seg / h);
-            const float a = -expm1(-od);
-            if (A + (1.0f - A) * a > thr) {
-                const float frac = -log((1.0f - thr) / (1.0f - A)) / od;
-                depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
-                break;
+            if (c.w > 0.0f) {
+                if (product) {
+                    const float p = P * (1.0f - fmin(c.w, UMBRA_ALPHA_MAX));
+                    if (k < n_full && !(p < p_thr)) {
+                        P = p;
+                        ++k;
+                        continue;
+                    }
+                    tau = -h_vox * log(P);
+                }
+                /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
+                 * alpha over seg / h steps of h_vox voxels). */
+                const float od = tf_extinction(c.w) * h_vox * (seg / h);
+                if (tau + od > tau_thr) {
+                    const float frac = (tau_thr - tau) / od;
+                    depth = ls_depth(S, o, t_start + clamp(frac, 0.0f, 1.0f) * seg);
+                    break;
+                }
+                tau += od;
+                P = exp(-tau / h_vox); /* rounding put the two tests apart: go on from tau */
             }
-            A += (1.0f - A) * a;
             ++k;
         }
     }

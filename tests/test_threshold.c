@@ -5,6 +5,8 @@
  *    d* = -ln(1 - threshold) / sigma (sigma = -ln(1 - alpha) per voxel) within one light step,
  *    for thresholds 0.2, 0.5, 0.8 and a vertical, an oblique and a point light; filtered lookups
  *    (7, 13, 21 taps) fall monotonically and pass 1/2 at the same depth;
+ *  - the march's product of transparencies and its sum of optical depths (tiny steps, threshold
+ *    near 1) both put the flip at the analytic crossing plus the bias, within 0.015 voxels;
  *  - a separate light transfer function drives the map (its alpha sets d*), and unsetting it
  *    returns to the view transfer function;
  *  - stress lights give finite factors in [0,1] and full light where nothing is in between;
@@ -127,6 +129,43 @@ static void test_threshold_slab_crossing_matches_analytic(void **state)
     umbra_volume_release(vol);
 }
 
+/* The march keeps the product of the segments' transparencies where the threshold's
+ * transmittance over a step, p_thr = (1 - threshold)^(1 / step), stays above 1e-30, and sums
+ * their optical depths below that (a float product would underflow): both find the analytic
+ * crossing of a homogeneous slab lit straight down (every texel's ray enters the top face), so
+ * the factor flips half a light step (the depth bias) behind it, to within the query spacing.
+ * Cases: step 0.5 at 0.5 and 0.9 (products), step 0.05 at 0.9 (p_thr 1e-20, product), step 0.02
+ * at 0.99 (p_thr 1e-100: the sum). */
+static void test_threshold_product_and_sum_marches_exact(void **state)
+{
+    (void)state;
+    const float alpha = 0.3f, sigma = -logf(1.0f - alpha), ds = 0.01f;
+    umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
+    umbra_transfer_function tf = mt_tf(ctx, 0.7f, 0.7f, 0.7f, alpha);
+    const umbra_light light = test_directional_light(0, -1, 0);
+    const struct {
+        float step, threshold;
+    } cases[] = {{0.5f, 0.5f}, {0.5f, 0.9f}, {0.05f, 0.9f}, {0.02f, 0.99f}};
+    umbra_renderer r = test_renderer_transmission(ctx, vol, tf, light, UMBRA_TRANSMISSION_GREY);
+    const float target[3] = {1.3f, 0.0f, -0.7f};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 64, 1);
+        s.threshold = cases[i].threshold;
+        s.map_step = cases[i].step;
+        assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
+        float entry[3], dir[3];
+        light_ray_into_box(&light, target, entry, dir);
+        float expect = -logf(1.0f - cases[i].threshold) / sigma + 0.5f * cases[i].step;
+        float flip = flip_distance(r, entry, dir, 30.0f, ds, 1);
+        if (!(fabsf(flip - expect) <= 1.5f * ds))
+            fail_msg("step %g, threshold %g: flips at %g voxels, expected %g (+-%g)",
+                     cases[i].step, cases[i].threshold, flip, expect, 1.5f * ds);
+    }
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(vol);
+}
+
 static void test_threshold_light_transfer_function_drives_map(void **state)
 {
     (void)state;
@@ -237,6 +276,7 @@ int main(int argc, char **argv)
         cmocka_set_test_filter(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threshold_slab_crossing_matches_analytic),
+        cmocka_unit_test(test_threshold_product_and_sum_marches_exact),
         cmocka_unit_test(test_threshold_light_transfer_function_drives_map),
         cmocka_unit_test(test_threshold_stress_lights_finite_and_lit),
         cmocka_unit_test(test_threshold_camera_move_reuses_map),
