@@ -15,8 +15,8 @@
  * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
  * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
  * analytic depth -ln(1 - threshold) / sigma rather than one rounded to a step. The march keeps
- * the optical depth tau = -ln(1 - A) instead of A (the same test and crossing, without an
- * exponential per segment). */
+ * the transmittance 1 - A of the whole segments as a product, not A (the same test and crossing
+ * up to rounding, without a logarithm or an exponential per segment: see the kernel). */
 
 #define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
 
@@ -94,7 +94,8 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
                     break;
                 }
                 tau += od;
-                P = exp(-tau / h_vox); /* rounding put the two tests apart: go on from tau */
+                if (product) /* rounding put the two tests apart: go on from tau */
+                    P = exp(-tau / h_vox);
             }
             ++k;
         }
