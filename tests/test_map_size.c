@@ -20,22 +20,6 @@
 #include "renderer_internal.h"
 #include "test_util.h"
 
-static umbra_context ctx;
-
-static int setup(void **state)
-{
-    (void)state;
-    ctx = test_context();
-    return ctx ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    umbra_context_release(ctx);
-    return 0;
-}
-
 /* Texels per voxel of each technique (the header's k). */
 static double k_of(umbra_shadow_technique t)
 {
@@ -52,7 +36,8 @@ static uint32_t round_bound(double n)
                                          : m;
 }
 
-static umbra_volume make_volume(uint32_t nx, uint32_t ny, uint32_t nz, const float spacing[3])
+static umbra_volume make_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                const float spacing[3])
 {
     size_t n = (size_t)nx * ny * nz;
     float *data = malloc(n * sizeof *data);
@@ -76,8 +61,8 @@ static umbra_volume make_volume(uint32_t nx, uint32_t ny, uint32_t nz, const flo
 
 /* The map size a renderer with the given technique and map_size builds for volume v under light
  * (one shadow query builds it), read from the stats; *mode gets the projection used. */
-static uint32_t built_size(umbra_volume v, umbra_light light, umbra_shadow_technique t,
-                           uint32_t map_size, uint32_t *mode)
+static uint32_t built_size(umbra_context ctx, umbra_volume v, umbra_light light,
+                           umbra_shadow_technique t, uint32_t map_size, uint32_t *mode)
 {
     umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, 0.05f);
     umbra_renderer r = test_renderer(ctx, v, tf, NULL, &light, NULL);
@@ -103,34 +88,34 @@ static uint32_t built_size(umbra_volume v, umbra_light light, umbra_shadow_techn
 
 static void test_auto_directional_follows_the_projected_box(void **state)
 {
-    (void)state;
+    umbra_context ctx = *state;
     uint32_t mode;
-    umbra_volume v = make_volume(100, 40, 70, NULL);
+    umbra_volume v = make_volume(ctx, 100, 40, 70, NULL);
     /* Down y the map spans x (100 voxels) and z (70): the wider side. */
-    assert_int_equal(built_size(v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, &mode),
                      round_bound(100.0));
     assert_int_equal(mode, UMBRA_LS_ORTHO);
     assert_int_equal(round_bound(100.0), 128);
     /* Along x it spans y (40) and z (70). */
-    assert_int_equal(built_size(v, test_directional_light(1, 0, 0), UMBRA_SHADOW_THRESHOLD,
+    assert_int_equal(built_size(ctx, v, test_directional_light(1, 0, 0), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(70.0));
     umbra_volume_release(v);
 
     /* A 60^3 cube seen along (1, 1, 0): z (60) and the face diagonal (60 sqrt 2). */
-    v = make_volume(60, 60, 60, NULL);
-    assert_int_equal(built_size(v, test_directional_light(1, 1, 0), UMBRA_SHADOW_CSSM,
+    v = make_volume(ctx, 60, 60, 60, NULL);
+    assert_int_equal(built_size(ctx, v, test_directional_light(1, 1, 0), UMBRA_SHADOW_CSSM,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(k_of(UMBRA_SHADOW_CSSM) * 60.0 * sqrt(2.0)));
     /* The same light gives each technique its own texels per voxel: 64, 192, 128. */
-    assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_CSSM,
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, 0, -1), UMBRA_SHADOW_CSSM,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(3.0 * 60.0));
-    assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_DEEP,
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, 0, -1), UMBRA_SHADOW_DEEP,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(2.0 * 60.0));
-    assert_int_equal(built_size(v, test_directional_light(0, 0, -1), UMBRA_SHADOW_THRESHOLD,
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, 0, -1), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(60.0));
     umbra_volume_release(v);
@@ -138,8 +123,8 @@ static void test_auto_directional_follows_the_projected_box(void **state)
     /* Anisotropic spacing: a voxel is the smallest spacing (0.5), so 64 x 64 voxels of 0.5 x 1
      * world units look 128 voxels wide along y. */
     const float spacing[3] = {0.5f, 1.0f, 1.0f};
-    v = make_volume(64, 64, 64, spacing);
-    assert_int_equal(built_size(v, test_directional_light(0, 0, 1), UMBRA_SHADOW_DEEP,
+    v = make_volume(ctx, 64, 64, 64, spacing);
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, 0, 1), UMBRA_SHADOW_DEEP,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(k_of(UMBRA_SHADOW_DEEP) * 128.0));
     umbra_volume_release(v);
@@ -147,28 +132,28 @@ static void test_auto_directional_follows_the_projected_box(void **state)
 
 static void test_auto_point_light_frustum_and_inside(void **state)
 {
-    (void)state;
+    umbra_context ctx = *state;
     uint32_t mode;
-    umbra_volume v = make_volume(60, 60, 60, NULL);
+    umbra_volume v = make_volume(ctx, 60, 60, 60, NULL);
     /* Light 150 above the centre: the frustum's tangent window is set by the near face's corners
      * (30 / 120 each side), measured at the centre's distance 150: 75 texels, more than the
      * directional 60 because the light is close. */
-    uint32_t near = built_size(v, test_point_light(0, 150, 0), UMBRA_SHADOW_THRESHOLD,
+    uint32_t near = built_size(ctx, v, test_point_light(0, 150, 0), UMBRA_SHADOW_THRESHOLD,
                                UMBRA_MAP_SIZE_AUTO, &mode);
     assert_int_equal(mode, UMBRA_LS_PERSPECTIVE);
     assert_int_equal(near, round_bound(60.0 / 120.0 * 150.0));
     /* Far away it tends to the directional size. */
-    assert_int_equal(built_size(v, test_point_light(0, 3000, 0), UMBRA_SHADOW_THRESHOLD,
+    assert_int_equal(built_size(ctx, v, test_point_light(0, 3000, 0), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(60.0 / 2970.0 * 3000.0));
     assert_int_equal(round_bound(60.0 / 2970.0 * 3000.0), round_bound(60.0));
     /* Inside the box: the octahedral map, sqrt(4 pi) R texels with R the farthest corner. */
-    assert_int_equal(built_size(v, test_point_light(10, 0, 0), UMBRA_SHADOW_CSSM,
+    assert_int_equal(built_size(ctx, v, test_point_light(10, 0, 0), UMBRA_SHADOW_CSSM,
                                 UMBRA_MAP_SIZE_AUTO, &mode),
                      round_bound(k_of(UMBRA_SHADOW_CSSM) * sqrt(4.0 * 3.14159265358979) *
                                  sqrt(40.0 * 40.0 + 2 * 30.0 * 30.0)));
     assert_int_equal(mode, UMBRA_LS_OCTAHEDRAL);
-    assert_int_equal(built_size(v, test_point_light(0, 0, 0), UMBRA_SHADOW_DEEP,
+    assert_int_equal(built_size(ctx, v, test_point_light(0, 0, 0), UMBRA_SHADOW_DEEP,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      round_bound(k_of(UMBRA_SHADOW_DEEP) * sqrt(4.0 * 3.14159265358979) *
                                  sqrt(3.0) * 30.0));
@@ -177,16 +162,16 @@ static void test_auto_point_light_frustum_and_inside(void **state)
 
 static void test_auto_is_bounded(void **state)
 {
-    (void)state;
-    umbra_volume v = make_volume(16, 16, 16, NULL);
-    assert_int_equal(built_size(v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
+    umbra_context ctx = *state;
+    umbra_volume v = make_volume(ctx, 16, 16, 16, NULL);
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      UMBRA_MAP_SIZE_AUTO_MIN);
     umbra_volume_release(v);
     /* 4 x 8 x 8 voxels, 600 world units long in x: 2400 voxels of the smallest spacing. */
     const float spacing[3] = {600.0f, 1.0f, 1.0f};
-    v = make_volume(4, 8, 8, spacing);
-    assert_int_equal(built_size(v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
+    v = make_volume(ctx, 4, 8, 8, spacing);
+    assert_int_equal(built_size(ctx, v, test_directional_light(0, -1, 0), UMBRA_SHADOW_THRESHOLD,
                                 UMBRA_MAP_SIZE_AUTO, NULL),
                      UMBRA_MAP_SIZE_AUTO_MAX);
     umbra_volume_release(v);
@@ -203,7 +188,7 @@ static void render_sphere(umbra_renderer r, umbra_shadow_desc s, uint32_t w, uin
 
 static void test_auto_renders_as_the_same_explicit_size(void **state)
 {
-    (void)state;
+    umbra_context ctx = *state;
     enum { N = 48, W = 48, H = 40 };
     float *data = malloc(N * N * N * sizeof *data);
     assert_non_null(data);
@@ -252,8 +237,8 @@ static void test_auto_renders_as_the_same_explicit_size(void **state)
 
 static void test_explicit_sizes_kept_and_stats_report_them(void **state)
 {
-    (void)state;
-    umbra_volume v = make_volume(40, 40, 40, NULL);
+    umbra_context ctx = *state;
+    umbra_volume v = make_volume(ctx, 40, 40, 40, NULL);
     umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, 0.05f);
     umbra_light light = test_directional_light(0.3f, -1.0f, 0.2f);
     umbra_renderer r = test_renderer(ctx, v, tf, NULL, &light, NULL);
@@ -305,5 +290,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_auto_renders_as_the_same_explicit_size),
         cmocka_unit_test(test_explicit_sizes_kept_and_stats_report_them),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
