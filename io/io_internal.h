@@ -69,19 +69,13 @@ int umbra__parse_uint(const char *s, size_t n, uint64_t max, uint64_t *out);
 int umbra__host_is_big_endian(void);
 void umbra__swap_bytes(void *data, size_t count, size_t width);
 
-/* As umbra__volume_from_host for voxels fill writes (umbra_volume_create_filled): straight into
- * the device's buffer where it can. */
+/* A volume whose voxels fill writes (umbra_volume_create_filled): straight into the device's
+ * buffer where it can. origin and directions (9 floats, unit axis directions) give the
+ * index-to-world transform, or are NULL for the centred box. */
 umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fill, void *user,
                                      umbra_scalar_type type, const uint32_t dims[3],
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out);
-
-/* Hands voxels in host memory (copied) to umbra_volume_create; origin and directions (9 floats,
- * unit axis directions) give the index-to-world transform, or are NULL for the centred box. */
-umbra_status umbra__volume_from_host(umbra_context ctx, const void *data, umbra_scalar_type type,
-                                     const uint32_t dims[3], const float spacing[3],
-                                     const float *origin, const float *directions,
-                                     umbra_volume *out);
 
 #ifdef __cplusplus
 }

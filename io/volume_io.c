@@ -271,26 +271,6 @@ void umbra_raw_desc_init(umbra_raw_desc *desc)
     desc->header_bytes = 0;
 }
 
-/* Hands voxels already in host memory to umbra_volume_create; origin and directions (9 floats,
- * unit axis directions) give the index-to-world transform, or are NULL for the centred box. */
-umbra_status umbra__volume_from_host(umbra_context ctx, const void *data, umbra_scalar_type type,
-                                  const uint32_t dims[3], const float spacing[3],
-                                  const float *origin, const float *directions, umbra_volume *out)
-{
-    umbra_volume_desc vd;
-    umbra_volume_desc_init(&vd);
-    vd.data = data;
-    vd.type = type;
-    memcpy(vd.dims, dims, sizeof vd.dims);
-    memcpy(vd.spacing, spacing, sizeof vd.spacing);
-    if (origin && directions) {
-        vd.transform_given = 1;
-        memcpy(vd.origin, origin, sizeof vd.origin);
-        memcpy(vd.directions, directions, sizeof vd.directions);
-    }
-    return umbra_volume_create(ctx, &vd, out);
-}
-
 /* What the raw reader's fill callback reads: the rest of f (path), byte-swapped if need be. */
 typedef struct raw_fill {
     umbra_context ctx;
