@@ -3,7 +3,7 @@
  * session.
  *
  * For each scene (bench/scenes/walnut.scene and bonsai.scene by default), shading on and off, and
- * each light-space technique (threshold, CSSM, deep; map size auto unless --map-size says), three
+ * each light-space technique (threshold, CSSM, deep; map size auto unless --map-size says), four
  * sequences of frames:
  *   camera  the camera orbits the target 3 degrees a frame; light and transfer function stay, so
  *           the shadow map is built once and re-used;
@@ -11,7 +11,10 @@
  *           rebuilds the map;
  *   opacity the transfer function's opacity is scaled by a factor that changes every frame (a
  *           new transfer function each frame, set on the renderer): the light pass uses it, so
- *           every frame rebuilds the map, and the view tables are rebuilt as well.
+ *           every frame rebuilds the map, and the view tables are rebuilt as well;
+ *   light-draft the light orbits as in light, with the map at one texel per voxel
+ *           (map_texels_per_voxel 1: what an application asks for while the user drags the light;
+ *           CSSM and deep only, at the auto size: the threshold map is built so anyway).
  * A frame's time is the host wall clock of umbra_renderer_render (build, render and read-back of
  * the image: what an application waits for). The unshadowed frame of the same view is rendered by
  * a second renderer (technique none) on the same volume in turn with the shadowed one, frame by
@@ -49,8 +52,8 @@ typedef struct options {
     const char *results, *device;
 } options;
 
-typedef enum sequence { SEQ_CAMERA, SEQ_LIGHT, SEQ_OPACITY, SEQ_COUNT } sequence;
-static const char *const sequence_names[SEQ_COUNT] = {"camera", "light", "opacity"};
+typedef enum sequence { SEQ_CAMERA, SEQ_LIGHT, SEQ_OPACITY, SEQ_LIGHT_DRAFT, SEQ_COUNT } sequence;
+static const char *const sequence_names[SEQ_COUNT] = {"camera", "light", "opacity", "light-draft"};
 
 typedef struct row {
     char scene[SCENE_NAME_MAX];
@@ -79,8 +82,9 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: umbra-bench interactive [options]\n"
             "  per scene, shading on and off, and technique: frames in which the camera orbits\n"
-            "  (map cached), the light orbits (map rebuilt) and the opacity changes (map and\n"
-            "  tables rebuilt); median and max ms per frame, each over the unshadowed frame\n"
+            "  (map cached), the light orbits (map rebuilt), the opacity changes (map and\n"
+            "  tables rebuilt) and the light orbits with draft maps (1 texel per voxel); median\n"
+            "  and max ms per frame, each over the unshadowed frame\n"
             "  --quick          3 frames, 1 warm-up, images capped at 192 pixels\n"
             "  --frames N       timed frames per sequence (default 24)\n"
             "  --warmup N       untimed frames before them (default 2)\n"
@@ -184,7 +188,7 @@ static umbra_status frame(session *S, sequence seq, int i, double *ms_shadowed, 
     umbra_transfer_function tf = NULL;
     if (seq == SEQ_CAMERA) {
         rotate_y(cam.eye, cam.target, STEP_DEGREES * (float)i);
-    } else if (seq == SEQ_LIGHT) {
+    } else if (seq == SEQ_LIGHT || seq == SEQ_LIGHT_DRAFT) {
         float zero[3] = {0.0f, 0.0f, 0.0f};
         if (light.type == UMBRA_LIGHT_DIRECTIONAL)
             rotate_y(light.direction, zero, STEP_DEGREES * (float)(i + 1));
@@ -213,13 +217,21 @@ static umbra_status frame(session *S, sequence seq, int i, double *ms_shadowed, 
     return st;
 }
 
-static umbra_status renderer_for(session *S, umbra_shadow_technique t, uint32_t map_size,
-                                 umbra_renderer *out)
+/* The shadow of a sequence: the technique at map_size, with k texels per voxel (0: its own). */
+static umbra_shadow_desc shadow_for(umbra_shadow_technique t, uint32_t map_size, float k)
 {
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = t;
     sd.map_size = map_size;
+    sd.map_texels_per_voxel = k;
+    return sd;
+}
+
+static umbra_status renderer_for(session *S, umbra_shadow_technique t, uint32_t map_size,
+                                 umbra_renderer *out)
+{
+    const umbra_shadow_desc sd = shadow_for(t, map_size, 0.0f);
     umbra_status st = umbra_renderer_create(S->ctx, out);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_volume(*out, S->scene.volume);
@@ -318,6 +330,14 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
             if ((st = renderer_for(&S, techs[t], o->map_size, &S.shadowed)) == UMBRA_SUCCESS)
                 st = renderer_for(&S, UMBRA_SHADOW_NONE, 0, &S.none);
             for (int q = 0; q < SEQ_COUNT && st == UMBRA_SUCCESS && *nrows < MAX_ROWS; ++q) {
+                if (q == SEQ_LIGHT_DRAFT) {
+                    /* The last sequence: the renderer switches to the draft for it. */
+                    if (techs[t] == UMBRA_SHADOW_THRESHOLD || o->map_size != UMBRA_MAP_SIZE_AUTO)
+                        continue;
+                    const umbra_shadow_desc draft = shadow_for(techs[t], o->map_size, 1.0f);
+                    if ((st = umbra_renderer_set_shadow(S.shadowed, &draft)) != UMBRA_SUCCESS)
+                        break;
+                }
                 row *r = &rows[*nrows];
                 memset(r, 0, sizeof *r);
                 snprintf(r->scene, sizeof r->scene, "%s", name);
@@ -399,7 +419,8 @@ static void write_results(const options *o, int argc, char **argv, umbra_context
     fprintf(f, "ms per frame, median / max, and over the unshadowed frame (median over median, "
                "max over max). camera: the camera orbits, the map is cached; light: the light "
                "orbits, every frame rebuilds; opacity: the transfer function changes every "
-               "frame. build: the shadow build's part of the shadowed frame "
+               "frame; light-draft: the light orbits with map_texels_per_voxel 1, the draft an "
+               "application asks for while the user drags the light (CSSM and deep). build: the shadow build's part of the shadowed frame "
                "(umbra_render_stats.shadow_build_ms, device time; 0 where the map is re-used): "
                "the rest of a frame is the ray caster and the read-back.\n\n");
     fprintf(f, "| scene | shading | technique | map | sequence | ms median | ms max | none "

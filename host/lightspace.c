@@ -27,6 +27,27 @@ static void basis_from(const float w_in[3], float u[3], float v[3], float w[3])
     v[2] = w[0] * u[1] - w[1] * u[0];
 }
 
+umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_desc *d,
+                                        const char *name)
+{
+    const char *fn = "umbra_renderer_set_shadow";
+    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: %s map_size %u must be 0 (auto) or lie in [16, 8192]", fn, name,
+                           d->map_size);
+    if (!(d->map_texels_per_voxel == 0.0f ||
+          (d->map_texels_per_voxel >= 0.25f && d->map_texels_per_voxel <= 8.0f)))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: %s map_texels_per_voxel %g must be 0 (the technique's own) or lie "
+                           "in [0.25, 8]",
+                           fn, name, d->map_texels_per_voxel);
+    if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: %s map_step %g voxels must lie in [0.01, 64]", fn, name,
+                           d->map_step);
+    return UMBRA_SUCCESS;
+}
+
 /* Texels per voxel UMBRA_MAP_SIZE_AUTO gives each technique (include/umbra/renderer.h has the
  * rule and the measurements behind these numbers). The threshold map stores one depth per texel:
  * a texel per voxel resolves what the volume holds. CSSM's lookup averages taps fixed in texels
@@ -34,12 +55,15 @@ static void basis_from(const float w_in[3], float u[3], float v[3], float w[3])
  * error is within 5% of a 1024^2 map's on the walnut and the spheres. The deep map takes the
  * nearest texel, so its error keeps falling with the size; two texels per voxel halve the error of
  * one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
-static double texels_per_voxel(umbra_shadow_technique t)
+static double texels_per_voxel(umbra_renderer r)
 {
+    if (r->shadow.map_texels_per_voxel > 0.0f)
+        return r->shadow.map_texels_per_voxel; /* the application's (a draft while the light moves) */
+    const umbra_shadow_technique t = r->tech->id;
     return t == UMBRA_SHADOW_CSSM ? 3.0 : t == UMBRA_SHADOW_DEEP ? 2.0 : 1.0;
 }
 
-/* UMBRA_MAP_SIZE_AUTO: texels_per_voxel per voxel of the box as the light sees it. extent is the
+/* UMBRA_MAP_SIZE_AUTO: texels_per_voxel(r) per voxel of the box as the light sees it. extent is the
  * wider side of the map's window in its own units (world units for an orthographic map, tangents
  * for a perspective one), scale the world length one window unit stands for at the box (1 for
  * orthographic, the distance to the box's centre for a perspective frustum); an octahedral map
@@ -52,7 +76,7 @@ static double texels_per_voxel(umbra_shadow_technique t)
 static uint32_t auto_map_size(umbra_renderer r, int mode, double extent, double scale, double far)
 {
     double voxel = umbra__voxel_world(r);
-    double n = texels_per_voxel(r->tech->id) *
+    double n = texels_per_voxel(r) *
                (mode == UMBRA_LS_OCTAHEDRAL ? sqrt(4.0 * 3.14159265358979) * far / voxel
                                             : extent * scale / voxel);
     if (!(n >= UMBRA_MAP_SIZE_AUTO_MIN)) /* NaN too */

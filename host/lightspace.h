@@ -16,4 +16,9 @@
  * in include/umbra/renderer.h); S->map_size holds the size used, which the builds must read. */
 void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
+/* The checks every light-space map makes of desc (map_size, map_texels_per_voxel, map_step), for
+ * umbra_renderer_set_shadow; name is the technique's, for the message. */
+umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_desc *d,
+                                        const char *name);
+
 #endif

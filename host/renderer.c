@@ -88,6 +88,7 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
     d->technique = UMBRA_SHADOW_NONE;
     d->reference_step = 0.25f;
     d->map_size = UMBRA_MAP_SIZE_AUTO;
+    d->map_texels_per_voxel = 0.0f;
     d->map_step = 0.5f;
     d->threshold = 0.5f;
     d->taps = 13;

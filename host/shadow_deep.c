@@ -53,13 +53,9 @@ static float deep_light_step(const umbra_shadow_desc *d) { return d->map_step; }
 static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
 {
     const char *fn = "umbra_renderer_set_shadow";
-    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep map_size %u must be 0 (auto) or lie in [16, 8192]", fn,
-                           d->map_size);
-    if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep map_step %g voxels must lie in [0.01, 64]", fn, d->map_step);
+    umbra_status st = umbra__lightspace_validate(r, d, "deep");
+    if (st != UMBRA_SUCCESS)
+        return st;
     if (!(d->epsilon >= 0.0f && d->epsilon <= 1.0f))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: deep epsilon %g must lie in [0, 1]", fn, d->epsilon);

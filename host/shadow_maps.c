@@ -35,14 +35,9 @@ static float map_light_step(const umbra_shadow_desc *d) { return d->map_step; }
 static umbra_status map_validate(umbra_renderer r, const umbra_shadow_desc *d, const char *name)
 {
     const char *fn = "umbra_renderer_set_shadow";
-    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_size %u must be 0 (auto) or lie in [16, 8192]", fn, name,
-                           d->map_size);
-    if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_step %g voxels must lie in [0.01, 64]", fn, name,
-                           d->map_step);
+    umbra_status st = umbra__lightspace_validate(r, d, name);
+    if (st != UMBRA_SUCCESS)
+        return st;
     if (d->taps != 1 && d->taps != 7 && d->taps != 13 && d->taps != 21)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: %s taps %u must be 1, 7, 13 or 21", fn, name, d->taps);

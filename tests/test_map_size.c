@@ -7,6 +7,9 @@
  *  - a point light outside the box gets its frustum measured at the box centre's distance (more
  *    than the directional size when the light is close); one inside gets the octahedral rule;
  *  - the bounds: a tiny volume gets UMBRA_MAP_SIZE_AUTO_MIN, a long one UMBRA_MAP_SIZE_AUTO_MAX;
+ *  - map_texels_per_voxel replaces k for every technique (a draft at 1 builds CSSM and deep maps
+ *    at the threshold map's size), a fixed size ignores it, a change of it alone rebuilds the
+ *    map, and values outside 0 or [0.25, 8] are refused by name with the renderer still usable;
  *  - an auto map renders the same pixels as the same size given explicitly (threshold, CSSM, deep
  *    blocked and fixed-budget), so the sizes auto picks suit the kernels' tiles and taps;
  *  - explicit sizes (not multiples of 32 too) are kept, and umbra_render_stats.map_size reports
@@ -61,8 +64,9 @@ static umbra_volume make_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uin
 
 /* The map size a renderer with the given technique and map_size builds for volume v under light
  * (one shadow query builds it), read from the stats; *mode gets the projection used. */
-static uint32_t built_size(umbra_context ctx, umbra_volume v, umbra_light light,
-                           umbra_shadow_technique t, uint32_t map_size, uint32_t *mode)
+static uint32_t built_size_k(umbra_context ctx, umbra_volume v, umbra_light light,
+                             umbra_shadow_technique t, uint32_t map_size, float k,
+                             uint32_t *mode)
 {
     umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, 0.05f);
     umbra_renderer r = test_renderer(ctx, v, tf, NULL, &light, NULL);
@@ -71,6 +75,7 @@ static uint32_t built_size(umbra_context ctx, umbra_volume v, umbra_light light,
     assert_int_equal(s.map_size, UMBRA_MAP_SIZE_AUTO); /* the default */
     s.technique = t;
     s.map_size = map_size;
+    s.map_texels_per_voxel = k;
     s.map_step = 8.0f; /* the size does not depend on the step; a long one keeps 2048^2 cheap */
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     const float p[3] = {0.0f, 0.0f, 0.0f};
@@ -84,6 +89,12 @@ static uint32_t built_size(umbra_context ctx, umbra_volume v, umbra_light light,
     umbra_renderer_release(r);
     umbra_transfer_function_release(tf);
     return st.map_size;
+}
+
+static uint32_t built_size(umbra_context ctx, umbra_volume v, umbra_light light,
+                           umbra_shadow_technique t, uint32_t map_size, uint32_t *mode)
+{
+    return built_size_k(ctx, v, light, t, map_size, 0.0f, mode);
 }
 
 static void test_auto_directional_follows_the_projected_box(void **state)
@@ -279,6 +290,64 @@ static void test_explicit_sizes_kept_and_stats_report_them(void **state)
     umbra_volume_release(v);
 }
 
+static void test_texels_per_voxel_replaces_the_techniques_k(void **state)
+{
+    umbra_context ctx = *state;
+    umbra_volume v = make_volume(ctx, 60, 60, 60, NULL);
+    const umbra_light down = test_directional_light(0, 0, -1);
+    /* A draft (1 texel per voxel): CSSM and deep at the threshold map's size, not 192 and 128. */
+    const umbra_shadow_technique ts[3] = {UMBRA_SHADOW_THRESHOLD, UMBRA_SHADOW_CSSM,
+                                          UMBRA_SHADOW_DEEP};
+    for (int i = 0; i < 3; ++i) {
+        assert_int_equal(built_size_k(ctx, v, down, ts[i], UMBRA_MAP_SIZE_AUTO, 1.0f, NULL),
+                         round_bound(60.0));
+        assert_int_equal(built_size_k(ctx, v, down, ts[i], UMBRA_MAP_SIZE_AUTO, 4.5f, NULL),
+                         round_bound(4.5 * 60.0));
+    }
+    assert_int_equal(round_bound(4.5 * 60.0), 288);
+    /* The bounds still hold, and a fixed size ignores it. */
+    assert_int_equal(built_size_k(ctx, v, down, UMBRA_SHADOW_DEEP, UMBRA_MAP_SIZE_AUTO, 0.25f, NULL),
+                     UMBRA_MAP_SIZE_AUTO_MIN);
+    assert_int_equal(built_size_k(ctx, v, down, UMBRA_SHADOW_CSSM, 100, 1.0f, NULL), 100);
+    umbra_volume_release(v);
+
+    /* A change of it alone rebuilds the map at the new size; the same value again reuses it. */
+    v = make_volume(ctx, 40, 40, 40, NULL);
+    umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, 0.05f);
+    umbra_renderer r = test_renderer(ctx, v, tf, NULL, &down, NULL);
+    umbra_shadow_desc s;
+    umbra_shadow_desc_init(&s);
+    assert_true(s.map_texels_per_voxel == 0.0f); /* the default: the technique's own */
+    s.technique = UMBRA_SHADOW_CSSM;
+    float img[16 * 12 * 4];
+    umbra_render_stats st;
+    render_sphere(r, s, 16, 12, img, &st);
+    assert_int_equal(st.map_size, round_bound(3.0 * 40.0));
+    s.map_texels_per_voxel = 1.0f;
+    render_sphere(r, s, 16, 12, img, &st);
+    assert_int_equal(st.shadow_rebuilt, 1);
+    assert_int_equal(st.map_size, round_bound(40.0));
+    render_sphere(r, s, 16, 12, img, &st);
+    assert_int_equal(st.shadow_rebuilt, 0);
+
+    /* Outside 0 or [0.25, 8]: refused by name; the renderer keeps its shadow and renders. */
+    const float bad[4] = {0.2f, 8.5f, -1.0f, NAN};
+    const char *said[4] = {"map_texels_per_voxel 0.2 must be 0", "map_texels_per_voxel 8.5 must",
+                           "map_texels_per_voxel -1 must", "map_texels_per_voxel nan must"};
+    for (int i = 0; i < 4; ++i) {
+        umbra_shadow_desc b = s;
+        b.map_texels_per_voxel = bad[i];
+        assert_int_equal(umbra_renderer_set_shadow(r, &b), UMBRA_ERROR_INVALID_ARGUMENT);
+        assert_true(test_message_contains(ctx, said[i]));
+    }
+    assert_int_equal(umbra_renderer_render(r, 16, 12, img), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+    assert_int_equal(st.map_size, round_bound(40.0));
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(v);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -289,6 +358,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_auto_is_bounded),
         cmocka_unit_test(test_auto_renders_as_the_same_explicit_size),
         cmocka_unit_test(test_explicit_sizes_kept_and_stats_report_them),
+        cmocka_unit_test(test_texels_per_voxel_replaces_the_techniques_k),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

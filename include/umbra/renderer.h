@@ -144,7 +144,10 @@ UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shad
  * voxels; a point light's frustum the same measured at the distance of the box's centre (the near
  * side gets more texels per voxel, the far side fewer); a point light inside or near the box
  * (octahedral map over every direction) k sqrt(4 pi) R / voxel, R the distance to the farthest
- * corner. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map
+ * corner. map_texels_per_voxel replaces k where it is set: an application that rebuilds the map
+ * every frame while the user drags the light can ask for 1 (a draft: CSSM and the deep map then
+ * cost about what the threshold map does, README "Moving the light") and go back to 0 when the
+ * light stops. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map
  * tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again
  * whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
  * what was chosen. On the walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
@@ -162,6 +165,10 @@ typedef struct umbra_shadow_desc {
     uint32_t map_size;           /* map resolution, map_size^2 texels: UMBRA_MAP_SIZE_AUTO
                                     (0, the default: chosen from the scene, rule below) or
                                     16..8192; stats.map_size reports the size built */
+    float map_texels_per_voxel;  /* UMBRA_MAP_SIZE_AUTO only: texels per voxel across the box's
+                                    projection, 0 (the default: the technique's own, 1 threshold,
+                                    3 CSSM, 2 deep; rule above) or [0.25, 8]; a fixed map_size
+                                    ignores it */
     float map_step;              /* light-ray step in voxels (default 0.5) */
     float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
                                     a texel's depth is stored (default 0.5); one grey depth per

@@ -176,8 +176,12 @@ void bind_options(nb::module_ &m)
     field(so, "reference_step", &umbra_shadow_desc::reference_step,
           "reference: shadow-ray step in voxels");
     field(so, "map_size", &umbra_shadow_desc::map_size,
-          "light-space maps: map_size^2 texels, 0 (MAP_SIZE_AUTO, the default: about one texel "
-          "per voxel seen from the light; stats.map_size says what was chosen) or 16..8192");
+          "light-space maps: map_size^2 texels, 0 (MAP_SIZE_AUTO, the default: "
+          "map_texels_per_voxel texels per voxel seen from the light; stats.map_size says what "
+          "was chosen) or 16..8192");
+    field(so, "map_texels_per_voxel", &umbra_shadow_desc::map_texels_per_voxel,
+          "light-space maps at MAP_SIZE_AUTO: texels per voxel, 0 (the technique's own: "
+          "threshold 1, cssm 3, deep 2) or 0.25..8; 1 is a draft while the light moves");
     field(so, "map_step", &umbra_shadow_desc::map_step,
           "light-space maps: light-ray step in voxels");
     field(so, "threshold", &umbra_shadow_desc::threshold,

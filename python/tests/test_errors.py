@@ -99,6 +99,8 @@ def test_bad_options_name_the_value(ctx):
     with s.renderer() as r:
         with raises_invalid(r"map_size 8 must be 0 \(auto\) or lie in \[16, 8192\]"):
             r.set_shadow(technique="deep", map_size=8)
+        with raises_invalid(r"map_texels_per_voxel 9 must be 0 .* or lie in \[0.25, 8\]"):
+            r.set_shadow(technique="cssm", map_texels_per_voxel=9)
         with pytest.raises(TypeError, match="unknown parameter 'mapsize'.*map_size"):
             r.render(8, 8, technique="deep", mapsize=64)
         with pytest.raises(TypeError, match=r"taps=-1 is not a valid int"):

@@ -107,6 +107,12 @@ def test_map_size_auto_is_the_default_and_reported(ctx, spheres):
         # the rule of include/umbra/renderer.h: a multiple of 32 within [64, 2048]
         assert 64 <= auto <= 2048 and auto % 32 == 0
         assert r.stats.shadow_memory_bytes == 4 * auto * auto
+        # a draft for CSSM (1 texel per voxel instead of 3) is the threshold map's size
+        assert umbra.ShadowOptions().map_texels_per_voxel == 0
+        r.render(32, 24, technique="cssm", map_texels_per_voxel=1)
+        assert r.stats.map_size == auto
+        r.render(32, 24, technique="cssm")
+        assert r.stats.map_size > auto
         r.render(32, 24, technique="none")
         assert r.stats.map_size == 0
 
