@@ -19,6 +19,7 @@
  * kernels/shadow_deep_budget.cl) but are compiled only into the build program
  * (DEEP_BUILD_KERNELS), not into every ray caster program. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -123,8 +124,9 @@ static umbra_status create_buffer(umbra_context ctx, size_t bytes, const char *w
 }
 
 /* The build program (kernels/shadow_deep.cl with its build kernels switched on, without the ray
- * caster, so it does not depend on how the renderer assembles that one), its three kernels, and
- * the tile edge the build's work-group size allows. */
+ * caster, so it does not depend on how the renderer assembles that one; the pre-filter's ray
+ * count compiled in, DEEP_SUB_RAYS), its three kernels, and the tile edge the build's
+ * work-group size allows. */
 static umbra_status ensure_program(umbra_renderer r, deep_state *s)
 {
     umbra_context ctx = r->ctx;
@@ -133,8 +135,10 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
                            "shadow_deep_budget.cl"};
     char options[300];
     cl_program program;
-    umbra__build_options(r, options, sizeof options - 32);
-    strcat(options, " -DDEEP_BUILD_KERNELS=1");
+    umbra__build_options(r, options, sizeof options - 48);
+    const size_t used = strlen(options);
+    snprintf(options + used, sizeof options - used, " -DDEEP_BUILD_KERNELS=1 -DDEEP_SUB_RAYS=%u",
+             r->shadow.prefilter);
     if ((st = umbra__program_get(ctx, files, 5, options, &program)) != UMBRA_SUCCESS)
         return st;
     if (program == s->program && s->k_build)
@@ -236,12 +240,11 @@ static umbra_status bind_march(umbra_renderer r, deep_state *s, cl_kernel k, cl_
     umbra_status st = umbra__bind_common(r, k, next);
     if (st != UMBRA_SUCCESS)
         return st;
-    cl_uint use_lut = s->lut_used ? 1u : 0u, prefilter = r->shadow.prefilter;
+    cl_uint use_lut = s->lut_used ? 1u : 0u;
     float eps = r->shadow.epsilon;
     cl_mem lut = s->lut_used ? s->lut : s->dummy;
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &lut));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof use_lut, &use_lut));
-    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof prefilter, &prefilter));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof eps, &eps));
 fail:
     return st;

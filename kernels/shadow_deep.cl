@@ -37,6 +37,17 @@
 #ifndef DEEP_BUILD_KERNELS
 #define DEEP_BUILD_KERNELS 0 /* the host's build program sets 1; the ray caster needs the lookup */
 #endif
+/* Sub-texel rays per texel (desc->prefilter, 1 or 5), a build option of the build program: with
+ * a constant count the compiler keeps a single ray's state, points and fit in registers and
+ * drops the merge of several rays' points, where a count read at run time kept every per-ray
+ * array in memory (issue #12: the 1-ray build on the walnut took ... of the time; the arithmetic
+ * and its order are unchanged, so the maps are the same bit for bit). */
+#ifndef DEEP_SUB_RAYS
+#define DEEP_SUB_RAYS 1
+#endif
+#if DEEP_SUB_RAYS != 1 && DEEP_SUB_RAYS != 5
+#error "DEEP_SUB_RAYS must be 1 or 5 (host/shadow_deep.c)"
+#endif
 
 /* Must match host/shadow_deep.h. */
 #define DEEP_LUT_RES 256          /* quantised scalar values per table axis */
@@ -44,8 +55,8 @@
 #define DEEP_LUT_NODES (DEEP_LUT_INTERIOR + 1) /* stored per entry: interior nodes + the end */
 #define DEEP_LUT_SUBSTEPS 64      /* integration sub-steps per segment when building the table */
 #define DEEP_LUT_TOL 1e-3f        /* an entry's tolerance when its node budget allows */
-#define DEEP_MAX_SUB 5            /* sub-texel rays per texel */
-#define DEEP_MAX_POINTS (DEEP_MAX_SUB * DEEP_LUT_NODES) /* distinct positions in one segment */
+#define DEEP_MAX_SUB 5            /* sub-texel rays per texel, at most (the pre-filter's taps) */
+#define DEEP_MAX_POINTS (DEEP_SUB_RAYS * DEEP_LUT_NODES) /* distinct positions in one segment */
 #define DEEP_MAX_EMIT (DEEP_MAX_POINTS + 6) /* nodes one march step can emit (see deep_step) */
 
 #if UMBRA_LIGHT_CHANNELS == 1
@@ -307,8 +318,7 @@ typedef struct DeepSub {
 } DeepSub;
 
 typedef struct DeepTexel {
-    DeepSub sub[DEEP_MAX_SUB];
-    int nsub;
+    DeepSub sub[DEEP_SUB_RAYS];
     int k, k_end;     /* current segment, one past the last */
     float base;       /* ray parameter of depth 0 */
     float zstep;      /* normalised depth per segment */
@@ -319,20 +329,19 @@ typedef struct DeepTexel {
 } DeepTexel;
 
 inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom g, int2 texel,
-                            uint prefilter, float eps)
+                            float eps)
 {
     const float h = S->step;
     float ta_min = UMBRA_INF, tb_max = -UMBRA_INF;
-    T->nsub = 0;
     T->base = 0.0f;
-    for (uint i = 0; i < prefilter && i < DEEP_MAX_SUB; ++i) {
-        float4 tap = prefilter == 1u ? (float4)(0.0f, 0.0f, 1.0f, 0.0f) : deep_taps[i];
+    for (int i = 0; i < DEEP_SUB_RAYS; ++i) {
+        float4 tap = DEEP_SUB_RAYS == 1 ? (float4)(0.0f, 0.0f, 1.0f, 0.0f) : deep_taps[i];
         float2 xy = convert_float2(texel) + 0.5f + tap.xy;
         float3 o, d;
         float2 t = ls_texel_ray(S, g, xy, &o, &d);
         if (i == 0)
             T->base = S->near_far[0] - (S->ls_mode == UMBRA_LS_ORTHO ? dot(o, F3(S->ls_w)) : 0.0f);
-        DeepSub *s = &T->sub[T->nsub++];
+        DeepSub *s = &T->sub[i];
         s->o = o;
         s->d = d;
         s->w = tap.z;
@@ -445,11 +454,11 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
     const float t0 = T->base + (float)T->k * h, t1 = t0 + h;
 
-    DeepPoints pts[DEEP_MAX_SUB];
-    light_t v_front[DEEP_MAX_SUB]; /* each sub-ray's visibility at the segment's front end */
+    DeepPoints pts[DEEP_SUB_RAYS];
+    light_t v_front[DEEP_SUB_RAYS]; /* each sub-ray's visibility at the segment's front end */
     light_t v_start = (light_t)(0.0f), v_end = (light_t)(0.0f);
     int any_points = 0, all_empty = 1, all_cells_empty = 1;
-    for (int i = 0; i < T->nsub; ++i) {
+    for (int i = 0; i < DEEP_SUB_RAYS; ++i) {
         DeepSub *s = &T->sub[i];
         DeepPoints *p = &pts[i];
         p->n = 0;
@@ -524,7 +533,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
         /* The union of the sub-rays' positions, sorted, without repeats. */
         float xs[DEEP_MAX_POINTS];
         int nx = 0;
-        for (int i = 0; i < T->nsub; ++i)
+        for (int i = 0; i < DEEP_SUB_RAYS; ++i)
             for (int j = 0; j < pts[i].n; ++j) {
                 float x = pts[i].x[j];
                 int q = nx;
@@ -549,7 +558,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
                 continue;
             last = x;
             light_t v = (light_t)(0.0f);
-            for (int i = 0; i < T->nsub; ++i)
+            for (int i = 0; i < DEEP_SUB_RAYS; ++i)
                 v += T->sub[i].w * deep_points_eval(&pts[i], v_front[i], x);
             float z = ((float)T->k + x) * T->zstep;
             deep_fit_push(&T->fit, z, v, T->eps, e, &ne);
@@ -563,7 +572,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     int k_next = T->k + 1;
     if (skip && !all_empty && all_cells_empty) {
         float jump = (float)T->k_end;
-        for (int i = 0; i < T->nsub; ++i) {
+        for (int i = 0; i < DEEP_SUB_RAYS; ++i) {
             const DeepSub *s = &T->sub[i];
             if (!(s->tb > s->ta) || s->tb <= t1)
                 continue;
@@ -581,7 +590,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     }
     if (skip && all_empty) {
         float jump = (float)T->k_end;
-        for (int i = 0; i < T->nsub; ++i) {
+        for (int i = 0; i < DEEP_SUB_RAYS; ++i) {
             const DeepSub *s = &T->sub[i];
             if (!(s->tb > s->ta) || s->tb <= t1)
                 continue;
@@ -621,7 +630,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
                          __global const UmbraShadow *S, __global const deep_node *lut,
-                         uint use_lut, uint prefilter, float eps, __global deep_node *nodes,
+                         uint use_lut, float eps, __global deep_node *nodes,
                          __global int *head, __global int *next, __global uint *counts,
                          volatile __global uint *counter, uint capacity, uint limit)
 {
@@ -643,7 +652,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
     DeepTexel st;
     st.done = 1;
     if (gx < n && gy < n)
-        deep_texel_init(&st, S, g, (int2)(gx, gy), prefilter, eps);
+        deep_texel_init(&st, S, g, (int2)(gx, gy), eps);
     deep_node pend[DEEP_MAX_EMIT];
     int npend = 0, ppos = 0;
     uint written = 0, layer_end = 0;

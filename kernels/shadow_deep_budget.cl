@@ -178,8 +178,8 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
                                __global const float4 *view_tf, __global const float4 *light_tf,
                                __global const uchar *view_bricks,
                                __global const ulong *light_cells, __global const UmbraShadow *S,
-                               __global const deep_node *lut, uint use_lut, uint prefilter,
-                               float eps, __global deep_node *out)
+                               __global const deep_node *lut, uint use_lut, float eps,
+                               __global deep_node *out)
 {
     (void)view_tf;
     (void)view_bricks;
@@ -191,7 +191,7 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
     const VolGeom g = vol_geom(F);
     __global deep_node *o = out + (size_t)(gy * n + gx) * (size_t)N;
     DeepTexel st;
-    deep_texel_init(&st, S, g, (int2)(gx, gy), prefilter, eps);
+    deep_texel_init(&st, S, g, (int2)(gx, gy), eps);
     deep_node e[DEEP_MAX_EMIT];
     DeepFixed fx;
     fx.cnt = 0;
