@@ -37,11 +37,12 @@
 #ifndef DEEP_BUILD_KERNELS
 #define DEEP_BUILD_KERNELS 0 /* the host's build program sets 1; the ray caster needs the lookup */
 #endif
-/* Sub-texel rays per texel (desc->prefilter, 1 or 5), a build option of the build program: with
- * a constant count the compiler keeps a single ray's state, points and fit in registers and
- * drops the merge of several rays' points, where a count read at run time kept every per-ray
- * array in memory (issue #12: the 1-ray build on the walnut took ... of the time; the arithmetic
- * and its order are unchanged, so the maps are the same bit for bit). */
+/* Sub-texel rays per texel (desc->prefilter, 1 or 5), a build option of the build program, not a
+ * kernel argument: with the count known the compiler sizes the per-ray arrays to it and can
+ * unroll the loops over the rays. The arithmetic and its order are unchanged, so the maps are
+ * the same bit for bit; the 1-ray build on the walnut (512^2) took 0.97x the time of the
+ * run-time count (two interleaved runs each, issue #12): less than hoped, the march itself is
+ * the cost. */
 #ifndef DEEP_SUB_RAYS
 #define DEEP_SUB_RAYS 1
 #endif
