@@ -102,11 +102,11 @@ static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float thr
         c->headline = H_THRESHOLD;
 }
 
-static void add_cssm(config_list *L, uint32_t map, uint32_t taps)
+static config *add_cssm(config_list *L, uint32_t map, uint32_t taps)
 {
     config *c = add_config(L, UMBRA_SHADOW_CSSM);
     if (!c)
-        return;
+        return NULL;
     c->desc.map_size = map;
     c->desc.taps = taps;
     char a[16], b[16];
@@ -115,13 +115,15 @@ static void add_cssm(config_list *L, uint32_t map, uint32_t taps)
              c->desc.seed);
     if (map == L->headline_map && taps == 13)
         c->headline = H_CSSM;
+    return c;
 }
 
-static void add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes, uint32_t prefilter)
+static config *add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes,
+                        uint32_t prefilter)
 {
     config *c = add_config(L, UMBRA_SHADOW_DEEP);
     if (!c)
-        return;
+        return NULL;
     c->desc.map_size = map;
     c->desc.epsilon = eps;
     c->desc.max_nodes = nodes;
@@ -136,6 +138,20 @@ static void add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes, ui
              map_name(map, b), eps, nodes, prefilter);
     if (map == L->headline_map && eps == 0.02f && prefilter == 1)
         c->headline = nodes == 0 ? H_DEEP : nodes == 3 ? H_DEEP3 : 0;
+    return c;
+}
+
+/* An auto-size row made a draft: one texel per voxel (map_texels_per_voxel 1, what an application
+ * asks for while the user drags the light), the threshold map's size, instead of the
+ * technique's own. */
+static void make_draft(config *c)
+{
+    if (!c)
+        return;
+    c->desc.map_texels_per_voxel = 1.0f;
+    size_t n = strlen(c->label), m = strlen(c->params);
+    snprintf(c->label + n, sizeof c->label - n, ", draft");
+    snprintf(c->params + m, sizeof c->params - m, ";map_texels_per_voxel=1");
 }
 
 static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
@@ -164,7 +180,8 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
  * Tables 3-4 (threshold, deep with 3 nodes per channel, CSSM with 13 taps; unbounded deep maps up
  * to 2048^2), one marked `papers deep` the deep-map paper's Table 1 (128^2-512^2 at epsilon 0.02
  * and 0.06 with the 5-tap pre-filter). On a 2-core CPU one 4096^2 build takes one to three
- * minutes, so the large maps are measured where the papers' tables need them. */
+ * minutes, so the large maps are measured where the papers' tables need them. CSSM and the deep
+ * map also run at auto size as a draft (make_draft): what a dragged light costs in accuracy. */
 static void build_configs(int quick, int papers, uint32_t max_map, float exact_step,
                           config_list *L)
 {
@@ -196,6 +213,7 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
     for (size_t i = 0; i < nmaps; ++i)
         if (maps[i] <= max_map)
             add_cssm(L, maps[i], 13);
+    make_draft(add_cssm(L, UMBRA_MAP_SIZE_AUTO, 13));
     add_cssm(L, L->headline_map, 7);
     if (!quick)
         add_cssm(L, 1024, 21);
@@ -203,6 +221,7 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
     for (size_t i = 0; i < nmaps && i < 4; ++i)
         if (maps[i] <= max_map)
             add_deep(L, maps[i], 0.02f, 0, 1);
+    make_draft(add_deep(L, UMBRA_MAP_SIZE_AUTO, 0.02f, 0, 1));
     add_deep(L, L->headline_map, 0.02f, 3, 1);
     if (!quick) {
         for (size_t i = 3; i < nmaps; ++i)
