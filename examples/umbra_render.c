@@ -62,8 +62,8 @@ static void usage(FILE *f)
         "  --reference-step S    reference: shadow-ray step in voxels (default 0.25)\n"
         "  --map-size auto|N     light-space map resolution N^2 (default auto: K texels per\n"
         "                        voxel seen from the light, 64..2048; 0 is auto too)\n"
-        "  --map-detail K        K for auto (default: threshold 1, cssm 3, deep 2; 1 is a\n"
-        "                        draft while the light moves)\n"
+        "  --map-texels-per-voxel K   K for auto (default: threshold 1, cssm 3, deep 2; 1 is\n"
+        "                        a draft while the light moves)\n"
         "  --map-step S --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
         "  --block-size K --prefilter 1|5 --no-lookup-table      light-space map parameters\n"
         "  --slice-distance S --subsamples N --preintegrated --cone-angle DEG  convolution\n");
@@ -362,7 +362,7 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--progress")) o->progress = 1;
         else if (FLAG("--no-progress")) o->progress = 0;
         else if (FLAG("--reference-step")) { NEED(); if (!parse_floats(v, &o->shadow.reference_step, 1)) BAD("--reference-step '%s' is not a number", v); }
-        else if (FLAG("--map-detail")) { NEED(); if (!parse_floats(v, &o->shadow.map_texels_per_voxel, 1)) BAD("--map-detail '%s' is not a number", v); }
+        else if (FLAG("--map-texels-per-voxel")) { NEED(); if (!parse_floats(v, &o->shadow.map_texels_per_voxel, 1)) BAD("--map-texels-per-voxel '%s' is not a number", v); }
         else if (FLAG("--map-size")) { NEED(); if (strcmp(v, "auto") == 0) o->shadow.map_size = UMBRA_MAP_SIZE_AUTO; else if (!parse_uint(v, &o->shadow.map_size)) BAD("--map-size '%s' is not 'auto' or a whole number", v); }
         else if (FLAG("--map-step")) { NEED(); if (!parse_floats(v, &o->shadow.map_step, 1)) BAD("--map-step '%s' is not a number", v); }
         else if (FLAG("--threshold")) { NEED(); if (!parse_floats(v, &o->shadow.threshold, 1)) BAD("--threshold '%s' is not a number", v); }

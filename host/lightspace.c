@@ -57,8 +57,8 @@ umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_des
  * one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
 static double texels_per_voxel(umbra_renderer r)
 {
-    if (r->shadow.map_texels_per_voxel > 0.0f)
-        return r->shadow.map_texels_per_voxel; /* the application's (a draft while the light moves) */
+    if (r->shadow.map_texels_per_voxel > 0.0f) /* the application's (a draft while it moves) */
+        return r->shadow.map_texels_per_voxel;
     const umbra_shadow_technique t = r->tech->id;
     return t == UMBRA_SHADOW_CSSM ? 3.0 : t == UMBRA_SHADOW_DEEP ? 2.0 : 1.0;
 }
