@@ -145,11 +145,11 @@ UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shad
  * side gets more texels per voxel, the far side fewer); a point light inside or near the box
  * (octahedral map over every direction) k sqrt(4 pi) R / voxel, R the distance to the farthest
  * corner. map_texels_per_voxel replaces k where it is set: an application that rebuilds the map
- * every frame while the user drags the light can ask for 1 (a draft: CSSM and the deep map then
- * cost about what the threshold map does, README "Moving the light") and go back to 0 when the
- * light stops. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map
- * tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again
- * whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
+ * every frame while the user drags the light can ask for 1 (a draft at the threshold map's size:
+ * CSSM builds 5x to 8x faster, the deep map 3x to 4x; README "Map size") and go back to 0 when
+ * the light stops. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole
+ * deep-map tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen
+ * again whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
  * what was chosen. On the walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
 #define UMBRA_MAP_SIZE_AUTO 0u
 #define UMBRA_MAP_SIZE_AUTO_MIN 64u
