@@ -420,7 +420,8 @@ static void write_results(const options *o, int argc, char **argv, umbra_context
                "max over max). camera: the camera orbits, the map is cached; light: the light "
                "orbits, every frame rebuilds; opacity: the transfer function changes every "
                "frame; light-draft: the light orbits with map_texels_per_voxel 1, the draft an "
-               "application asks for while the user drags the light (CSSM and deep). build: the shadow build's part of the shadowed frame "
+               "application asks for while the user drags the light (CSSM and deep). build: the "
+               "shadow build's part of the shadowed frame "
                "(umbra_render_stats.shadow_build_ms, device time; 0 where the map is re-used): "
                "the rest of a frame is the ray caster and the read-back.\n\n");
     fprintf(f, "| scene | shading | technique | map | sequence | ms median | ms max | none "
