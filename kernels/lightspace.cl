@@ -28,7 +28,7 @@ inline float3 ls_oct_decode(float2 e)
 }
 
 /* World point -> (x texel, y texel, depth01). */
-inline float3 ls_world_to_map(__global const UmbraShadow *S, float3 p)
+UMBRA_INLINE float3 ls_world_to_map(__global const UmbraShadow *S, float3 p)
 {
     float3 u = F3(S->ls_u), v = F3(S->ls_v), w = F3(S->ls_w);
     float n = (float)S->map_size;
@@ -130,12 +130,14 @@ inline bool ls_taps_inside(int n, int2 t)
 
 inline int ls_tap_offset(int n, uint j) { return ls_taps[j].y * n + ls_taps[j].x; }
 
-/* Index of texel t in the map, or -1 outside it. An octahedral map covers every direction and its
- * border folds onto itself (the octahedron's lower faces meet there), so a tap that crosses the
- * border continues mirrored on the other side of the edge's midpoint; elsewhere outside is -1. */
-inline int ls_texel_index(__global const UmbraShadow *S, int2 t)
+/* Texel t folded into the map, and whether it lies in it. An octahedral map covers every
+ * direction and its border folds onto itself (the octahedron's lower faces meet there), so a tap
+ * that crosses the border continues mirrored on the other side of the edge's midpoint; elsewhere
+ * a texel outside the map is not in it. */
+inline bool ls_fold_texel(__global const UmbraShadow *S, int2 *texel)
 {
     const int n = (int)S->map_size;
+    int2 t = *texel;
     if (S->ls_mode == UMBRA_LS_OCTAHEDRAL) {
         if (t.x < 0 || t.x >= n) {
             t.x = t.x < 0 ? -1 - t.x : 2 * n - 1 - t.x;
@@ -146,7 +148,12 @@ inline int ls_texel_index(__global const UmbraShadow *S, int2 t)
             t.x = n - 1 - t.x;
         }
     }
-    if (t.x < 0 || t.y < 0 || t.x >= n || t.y >= n)
-        return -1;
-    return t.y * n + t.x;
+    *texel = t;
+    return t.x >= 0 && t.y >= 0 && t.x < n && t.y < n;
+}
+
+/* Index of texel t in the map (folded as above), or -1 outside it. */
+inline int ls_texel_index(__global const UmbraShadow *S, int2 t)
+{
+    return ls_fold_texel(S, &t) ? t.y * (int)S->map_size + t.x : -1;
 }

@@ -112,7 +112,7 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
 }
 
 /* Table 2: per channel, the fraction of the taps whose stored depth lies beyond p's. */
-inline float3 cssm_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
+UMBRA_INLINE float3 cssm_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
 {
     const float3 m = ls_world_to_map(S, p);
     int2 base;

@@ -755,19 +755,17 @@ inline float3 deep_shadow(__global const UmbraShadow *S, __global const deep_nod
 {
     float3 m = ls_world_to_map(S, p);
     int2 t;
-    if (!isfinite(m.z) || !ls_base_texel(S, m.xy, &t))
-        return (float3)(1.0f);
-    const int idx = ls_texel_index(S, t);
-    if (idx < 0)
+    if (!isfinite(m.z) || !ls_base_texel(S, m.xy, &t) || !ls_fold_texel(S, &t))
         return (float3)(1.0f);
     const int n = (int)S->map_size;
+    const int idx = t.y * n + t.x;
     const int fixed = S->max_nodes > 0u;
     const uint K = S->block_size;
-    const int T = (int)S->deep_tile;
+    /* The tile is a power of two (host/shadow_deep.c): shifts and masks, not four divisions. */
+    const int T = (int)S->deep_tile, shift = 31 - (int)clz((uint)T);
     const size_t T2 = (size_t)(T * T);
-    const int tx = idx % n, ty = idx / n;
-    const int tile = (ty / T) * (int)S->tiles_per_row + tx / T;
-    const int lane = (ty % T) * T + tx % T;
+    const int tile = (t.y >> shift) * (int)S->tiles_per_row + (t.x >> shift);
+    const int lane = ((t.y & (T - 1)) << shift) + (t.x & (T - 1));
     const size_t base = (size_t)idx * S->max_nodes;
     const int count = fixed ? (int)S->max_nodes : (int)counts[idx];
     const float d = m.z;
