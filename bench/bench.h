@@ -32,6 +32,7 @@ int bench_accuracy(int argc, char **argv); /* bench/accuracy.c */
 int bench_readme(int argc, char **argv);   /* bench/readme.c */
 int bench_scale(int argc, char **argv);    /* bench/scale.c */
 int bench_interactive(int argc, char **argv); /* bench/interactive.c */
+int bench_builds(int argc, char **argv);   /* bench/builds.c */
 
 /* ---- timing -------------------------------------------------------------------------------------- */
 

@@ -16,6 +16,8 @@ static const bench_command commands[] = {
      "every shadow technique vs the exact reference: error, time, memory (CSV, plots)"},
     {"interactive", bench_interactive,
      "frames of an interactive session: camera orbit, light orbit, opacity edits, per technique"},
+    {"builds", bench_builds,
+     "light-space map builds at equal map size: threshold, CSSM, deep; grey and coloured"},
     {"readme", bench_readme,
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
     {"scale", bench_scale,
