@@ -45,7 +45,7 @@
 #define QUICK_MAX_SIDE 192u
 
 typedef struct options {
-    char scenes[256], techniques[128], scene_dir[1024];
+    char scenes[256], techniques[128], sequences[128], scene_dir[1024];
     int frames, warmup, quick;
     uint32_t width, height;   /* 0: the scene's size (capped at QUICK_MAX_SIDE with --quick) */
     uint32_t map_size;        /* UMBRA_MAP_SIZE_AUTO by default */
@@ -91,6 +91,7 @@ static void usage(FILE *f)
             "  --size WxH       image size (default: the scene's)\n"
             "  --scenes A,B     scene files' stems (default walnut,bonsai)\n"
             "  --techniques A,B (default threshold,cssm,deep)\n"
+            "  --sequences A,B  (default camera,light,opacity,light-draft)\n"
             "  --map-size auto|N  map size of the light-space techniques (default auto)\n"
             "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
             "  --results DIR    also write DIR/interactive.csv and DIR/interactive.md\n"
@@ -104,6 +105,7 @@ static int parse_options(int argc, char **argv, options *o)
     o->warmup = 2;
     snprintf(o->scenes, sizeof o->scenes, "walnut,bonsai");
     snprintf(o->techniques, sizeof o->techniques, "threshold,cssm,deep");
+    snprintf(o->sequences, sizeof o->sequences, "camera,light,opacity,light-draft");
     snprintf(o->scene_dir, sizeof o->scene_dir, "%s/bench/scenes", UMBRA_SOURCE_DIR);
     int frames_given = 0, warmup_given = 0;
     for (int i = 1; i < argc; ++i) {
@@ -126,6 +128,8 @@ static int parse_options(int argc, char **argv, options *o)
             snprintf(o->scenes, sizeof o->scenes, "%s", v);
         } else if (strcmp(a, "--techniques") == 0 && v) {
             snprintf(o->techniques, sizeof o->techniques, "%s", v);
+        } else if (strcmp(a, "--sequences") == 0 && v) {
+            snprintf(o->sequences, sizeof o->sequences, "%s", v);
         } else if (strcmp(a, "--map-size") == 0 && v &&
                    (strcmp(v, "auto") == 0 || !bench_parse_int(v, 16, 8192, &l))) {
             o->map_size = strcmp(v, "auto") == 0 ? UMBRA_MAP_SIZE_AUTO : (uint32_t)l;
@@ -330,6 +334,8 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
             if ((st = renderer_for(&S, techs[t], o->map_size, &S.shadowed)) == UMBRA_SUCCESS)
                 st = renderer_for(&S, UMBRA_SHADOW_NONE, 0, &S.none);
             for (int q = 0; q < SEQ_COUNT && st == UMBRA_SUCCESS && *nrows < MAX_ROWS; ++q) {
+                if (!in_list(o->sequences, sequence_names[q]))
+                    continue;
                 if (q == SEQ_LIGHT_DRAFT) {
                     /* The last sequence: the renderer switches to the draft for it. */
                     if (techs[t] == UMBRA_SHADOW_THRESHOLD || o->map_size != UMBRA_MAP_SIZE_AUTO)
