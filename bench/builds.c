@@ -207,7 +207,9 @@ static umbra_status run_size(umbra_context ctx, const options *o, const char *na
             st = umbra_renderer_set_light(r[v], &light);
             if (st == UMBRA_SUCCESS)
                 st = umbra_renderer_render(r[v], IMAGE_SIDE, IMAGE_SIDE, image);
-            if (st == UMBRA_SUCCESS && (st = umbra_renderer_get_stats(r[v], &stats)) == UMBRA_SUCCESS)
+            if (st == UMBRA_SUCCESS)
+                st = umbra_renderer_get_stats(r[v], &stats);
+            if (st == UMBRA_SUCCESS)
                 ms[v * rounds + i] = stats.shadow_build_ms;
         }
     }
@@ -266,7 +268,7 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
     return st == UMBRA_SUCCESS ? 0 : 1;
 }
 
-/* ---- the report -------------------------------------------------------------------------------- */
+/* ---- the report ------------------------------------------------------------------------------ */
 
 /* Row i's median over the baseline's (or the matched threshold's) of the same scene and size:
  * rows come in groups of VARIANTS, in the order of variants[]. */

@@ -214,8 +214,9 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                 }
             }
             if (pending) {
-                float3 s = SHADOW_FACTOR(sr, preint_size ? p_pend + (h * emission_depth(c_pend.w)) * d
-                                                         : shadow_point(p_pend, d, h, c_pend.w));
+                const float3 p_light = preint_size ? p_pend + (h * emission_depth(c_pend.w)) * d
+                                                   : shadow_point(p_pend, d, h, c_pend.w);
+                float3 s = SHADOW_FACTOR(sr, p_light);
                 float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p_pend)
                                                             : (float3)(0.0f);
                 float3 lit = shade_sample(F, c_pend.xyz, s, p_pend, -d, grad, l_ray, hv_ray);

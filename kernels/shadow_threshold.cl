@@ -104,7 +104,8 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
 }
 
 /* Fraction of the taps around p's texel whose stored depth p does not lie beyond. */
-UMBRA_INLINE float threshold_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
+UMBRA_INLINE float threshold_lookup(__global const UmbraShadow *S, __global const float *map,
+                                    float3 p)
 {
     const float3 m = ls_world_to_map(S, p);
     int2 base;
