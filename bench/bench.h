@@ -86,6 +86,17 @@ void bench_cpu_model(char *buf, size_t size);
 /* The OpenCL device umbra runs on, with its compute units and sampler back end. */
 void bench_device_description(umbra_context ctx, char *buf, size_t size);
 
+/* ---- results files ------------------------------------------------------------------------------ */
+
+/* Opens DIR/<subcommand>.<ext> ("csv", "md") for writing, creating DIR if it is missing; NULL,
+ * with "umbra-bench <subcommand>: cannot write PATH" on stderr, where it cannot. */
+FILE *bench_results_open(const char *dir, const char *subcommand, const char *ext);
+
+/* The head of a results .md: "# umbra-bench <subcommand>", then the date (UTC), the command line
+ * (argv[0] the subcommand), the OpenCL device (bench_device_description) and the CPU. */
+void bench_results_header(FILE *f, const char *subcommand, int argc, char **argv,
+                          const char *device);
+
 /* ---- command-line helpers ---------------------------------------------------------------------------- */
 
 /* Strict parsers: the whole string must be a number in range; return 0 on success. */

@@ -173,6 +173,32 @@ void bench_device_description(umbra_context ctx, char *buf, size_t size)
              umbra_context_sampler(ctx) == UMBRA_SAMPLER_IMAGE ? "image" : "buffer");
 }
 
+/* ---- results files ------------------------------------------------------------------------------ */
+
+FILE *bench_results_open(const char *dir, const char *subcommand, const char *ext)
+{
+    char path[1200];
+    mkdir(dir, 0777); /* may exist already; fopen below reports real trouble */
+    snprintf(path, sizeof path, "%s/%s.%s", dir, subcommand, ext);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        fprintf(stderr, "umbra-bench %s: cannot write %s\n", subcommand, path);
+    return f;
+}
+
+void bench_results_header(FILE *f, const char *subcommand, int argc, char **argv,
+                          const char *device)
+{
+    char cpu[600], date[64];
+    time_t now = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
+    bench_cpu_model(cpu, sizeof cpu);
+    fprintf(f, "# umbra-bench %s\n\n- date: %s\n- command: `", subcommand, date);
+    for (int i = 0; i < argc; ++i)
+        fprintf(f, "%s%s", i ? " " : "umbra-bench ", argv[i]);
+    fprintf(f, "`\n- OpenCL device: %s\n- CPU: %s\n", device, cpu);
+}
+
 /* ---- the procedural stand-in for the bonsai ---------------------------------------------------------------
  *
  * A 256^3 uint8 volume built to load a ray caster the way the bonsai CT does, not to look like

@@ -30,8 +30,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
 
 #include "bench.h"
 #include "scene_file.h"
@@ -395,29 +393,16 @@ static void csv_rows(FILE *f, const row *rows, int n)
 static void write_results(const options *o, int argc, char **argv, umbra_context ctx,
                           const row *rows, int n)
 {
-    char path[1100], cpu[600], device[600], date[64];
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
-    bench_cpu_model(cpu, sizeof cpu);
+    char device[600];
     bench_device_description(ctx, device, sizeof device);
-    mkdir(o->results, 0777); /* may exist already; fopen below reports real trouble */
-    snprintf(path, sizeof path, "%s/interactive.csv", o->results);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "umbra-bench interactive: cannot write %s\n", path);
+    FILE *f = bench_results_open(o->results, "interactive", "csv");
+    if (!f)
         return;
-    }
     csv_rows(f, rows, n);
     fclose(f);
-    snprintf(path, sizeof path, "%s/interactive.md", o->results);
-    if (!(f = fopen(path, "w"))) {
-        fprintf(stderr, "umbra-bench interactive: cannot write %s\n", path);
+    if (!(f = bench_results_open(o->results, "interactive", "md")))
         return;
-    }
-    fprintf(f, "# umbra-bench interactive\n\n- date: %s\n- command: `", date);
-    for (int i = 0; i < argc; ++i)
-        fprintf(f, "%s%s", i ? " " : "umbra-bench ", argv[i]);
-    fprintf(f, "`\n- OpenCL device: %s\n- CPU: %s\n", device, cpu);
+    bench_results_header(f, "interactive", argc, argv, device);
     fprintf(f, "- per sequence %d timed frames after %d warm-up frames; a frame is the wall time "
                "of umbra_renderer_render (build, render, read-back); the unshadowed frame of the "
                "same view is rendered in turn with it (bench/interactive.c)\n\n",

@@ -34,9 +34,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "bench.h"
@@ -383,33 +381,17 @@ static void write_results(const options *o, int argc, char **argv, const bench_v
                           const char *device, const bench_case *cases, int ncases,
                           const umbra_render_desc *shaded, const double load[2])
 {
-    char path[1100], cpu[600], date[64];
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
-    bench_cpu_model(cpu, sizeof cpu);
-    mkdir(o->results, 0777); /* may exist already; fopen below reports real trouble */
-    snprintf(path, sizeof path, "%s/raycast.csv", o->results);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "umbra-bench raycast: cannot write %s\n", path);
+    FILE *f = bench_results_open(o->results, "raycast", "csv");
+    if (!f)
         return;
-    }
     fprintf(f, "%s\n", BENCH_CSV_HEADER);
     for (int c = 0; c < ncases; ++c)
         for (int i = 0; i < cases[c].nrows; ++i)
             bench_csv_row(f, cases[c].rows[i].name, cases[c].rows[i].t, cases[c].rows[i].samples);
     fclose(f);
-    snprintf(path, sizeof path, "%s/raycast.md", o->results);
-    f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "umbra-bench raycast: cannot write %s\n", path);
+    if (!(f = bench_results_open(o->results, "raycast", "md")))
         return;
-    }
-    fprintf(f, "# umbra-bench raycast\n\n");
-    fprintf(f, "- date: %s\n- command: `", date);
-    for (int i = 0; i < argc; ++i)
-        fprintf(f, "%s%s", i ? " " : "umbra-bench ", argv[i]);
-    fprintf(f, "`\n- OpenCL device: %s\n- CPU: %s\n", device, cpu);
+    bench_results_header(f, "raycast", argc, argv, device);
 #ifdef _OPENMP
     fprintf(f, "- native C: OpenMP, %d threads\n", omp_get_max_threads());
 #else
