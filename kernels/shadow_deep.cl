@@ -315,6 +315,8 @@ typedef struct DeepSub {
     float w;        /* filter weight */
     float s_prev;   /* scalar at the current segment's front end, if has_prev */
     int has_prev;
+    float s_next;   /* scalar at the back end of segment k_next, sampled ahead */
+    int k_next;     /* -1: none */
     light_t v;      /* visibility at the current segment's front end */
 } DeepSub;
 
@@ -349,6 +351,8 @@ inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom
         s->v = (light_t)(1.0f);
         s->has_prev = 0;
         s->s_prev = 0.0f;
+        s->s_next = 0.0f;
+        s->k_next = -1;
         /* A ray that misses (or grazes) the box keeps an empty interval and its weight: lit. */
         s->ta = t.x;
         s->tb = (t.y > t.x && isfinite(t.x) && isfinite(t.y)) ? t.y : t.x;
@@ -498,7 +502,16 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
         const int full = a <= t0 && b >= t1;
         if (full && use_lut) {
             float sf = s->has_prev ? s->s_prev : sample_volume(vol, g, pa);
-            float sb = sample_volume(vol, g, pb);
+            float sb = s->k_next == T->k ? s->s_next : sample_volume(vol, g, pb);
+            /* The next segment's back end, sampled before this segment's table entry and fit so
+             * that its loads overlap them; at the position the next step computes (t1 there is
+             * its t0 + h), so the value is the one it would sample. */
+            const float t1_next = (T->base + (float)(T->k + 1) * h) + h;
+            s->k_next = -1;
+            if (t1_next <= s->tb) {
+                s->s_next = sample_volume(vol, g, s->o + t1_next * s->d);
+                s->k_next = T->k + 1;
+            }
             s->s_prev = sb;
             s->has_prev = 1;
             size_t pair = (size_t)deep_quant(sf) * DEEP_LUT_RES + (size_t)deep_quant(sb);
