@@ -286,18 +286,18 @@ static void csv_rows(FILE *f, const row *rows, int n)
                 over(rows, i, MATCHED));
 }
 
-static void write_results(const options *o, int argc, char **argv, umbra_context ctx,
-                          const row *rows, int n)
+static int write_results(const options *o, int argc, char **argv, umbra_context ctx,
+                         const row *rows, int n)
 {
     char device[600];
     bench_device_description(ctx, device, sizeof device);
     FILE *f = bench_results_open(o->results, "builds", "csv");
     if (!f)
-        return;
+        return -1;
     csv_rows(f, rows, n);
     fclose(f);
     if (!(f = bench_results_open(o->results, "builds", "md")))
-        return;
+        return -1;
     bench_results_header(f, "builds", argc, argv, device);
     fprintf(f, "- median of %d builds per variant after %d warm-up builds, the variants in turn "
                "each round; the build's own time (umbra_render_stats.shadow_build_ms) "
@@ -315,6 +315,7 @@ static void write_results(const options *o, int argc, char **argv, umbra_context
                 over(rows, i, MATCHED));
     fclose(f);
     fprintf(stderr, "wrote %s/builds.csv and %s/builds.md\n", o->results, o->results);
+    return 0;
 }
 
 int bench_builds(int argc, char **argv)
@@ -338,8 +339,8 @@ int bench_builds(int argc, char **argv)
          name = strtok_r(NULL, ",", &save))
         failures += run_scene(ctx, &o, name, rows, &n);
     csv_rows(stdout, rows, n);
-    if (o.results)
-        write_results(&o, argc, argv, ctx, rows, n);
+    if (o.results && write_results(&o, argc, argv, ctx, rows, n) != 0)
+        ++failures; /* a results file that cannot be written (the message is on stderr) */
     free(rows);
     umbra_context_release(ctx);
     return failures ? 1 : 0;

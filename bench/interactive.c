@@ -390,18 +390,18 @@ static void csv_rows(FILE *f, const row *rows, int n)
     }
 }
 
-static void write_results(const options *o, int argc, char **argv, umbra_context ctx,
-                          const row *rows, int n)
+static int write_results(const options *o, int argc, char **argv, umbra_context ctx,
+                         const row *rows, int n)
 {
     char device[600];
     bench_device_description(ctx, device, sizeof device);
     FILE *f = bench_results_open(o->results, "interactive", "csv");
     if (!f)
-        return;
+        return -1;
     csv_rows(f, rows, n);
     fclose(f);
     if (!(f = bench_results_open(o->results, "interactive", "md")))
-        return;
+        return -1;
     bench_results_header(f, "interactive", argc, argv, device);
     fprintf(f, "- per sequence %d timed frames after %d warm-up frames; a frame is the wall time "
                "of umbra_renderer_render (build, render, read-back); the unshadowed frame of the "
@@ -433,6 +433,7 @@ static void write_results(const options *o, int argc, char **argv, umbra_context
     }
     fclose(f);
     fprintf(stderr, "wrote %s/interactive.csv and %s/interactive.md\n", o->results, o->results);
+    return 0;
 }
 
 int bench_interactive(int argc, char **argv)
@@ -456,8 +457,8 @@ int bench_interactive(int argc, char **argv)
          name = strtok_r(NULL, ",", &save))
         failures += run_scene(ctx, &o, name, rows, &n);
     csv_rows(stdout, rows, n);
-    if (o.results)
-        write_results(&o, argc, argv, ctx, rows, n);
+    if (o.results && write_results(&o, argc, argv, ctx, rows, n) != 0)
+        ++failures; /* a results file that cannot be written (the message is on stderr) */
     free(rows);
     umbra_context_release(ctx);
     return failures ? 1 : 0;

@@ -377,20 +377,20 @@ static double load_average(void)
     return load;
 }
 
-static void write_results(const options *o, int argc, char **argv, const bench_volume *v,
-                          const char *device, const bench_case *cases, int ncases,
+static int write_results(const options *o, int argc, char **argv, const bench_volume *v,
+                         const char *device, const bench_case *cases, int ncases,
                           const umbra_render_desc *shaded, const double load[2])
 {
     FILE *f = bench_results_open(o->results, "raycast", "csv");
     if (!f)
-        return;
+        return -1;
     fprintf(f, "%s\n", BENCH_CSV_HEADER);
     for (int c = 0; c < ncases; ++c)
         for (int i = 0; i < cases[c].nrows; ++i)
             bench_csv_row(f, cases[c].rows[i].name, cases[c].rows[i].t, cases[c].rows[i].samples);
     fclose(f);
     if (!(f = bench_results_open(o->results, "raycast", "md")))
-        return;
+        return -1;
     bench_results_header(f, "raycast", argc, argv, device);
 #ifdef _OPENMP
     fprintf(f, "- native C: OpenMP, %d threads\n", omp_get_max_threads());
@@ -451,6 +451,7 @@ static void write_results(const options *o, int argc, char **argv, const bench_v
     }
     fclose(f);
     fprintf(stderr, "wrote %s/raycast.csv and %s/raycast.md\n", o->results, o->results);
+    return 0;
 }
 
 static void save_png(umbra_context ctx, const char *prefix, const char *name, uint32_t w,
@@ -749,9 +750,9 @@ int bench_raycast(int argc, char **argv)
             save_png(ctx, o.save, n_umbra, o.width, o.height, cases[c].img_umbra);
             save_png(ctx, o.save, n_native, o.width, o.height, cases[c].img_native);
         }
-    if (o.results)
-        write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded, load);
-    status = 0;
+    /* A results file that cannot be written fails the run (the message is on stderr). */
+    status = o.results && write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded,
+                                        load) != 0;
 done:
     if (vtk_running)
         vtk_stop(&peer);
