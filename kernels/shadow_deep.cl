@@ -315,6 +315,9 @@ typedef struct DeepSub {
     float w;        /* filter weight */
     float s_prev;   /* scalar at the current segment's front end, if has_prev */
     int has_prev;
+    float3 xo, xd;  /* the ray in voxel coordinates (deep_point_class) */
+    float t_class;  /* the last segment's back end, and its class */
+    int class_b;
     float s_next;   /* scalar at the back end of segment k_next, sampled ahead */
     int k_next;     /* -1: none */
     light_t v;      /* visibility at the current segment's front end */
@@ -353,6 +356,10 @@ inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom
         s->s_prev = 0.0f;
         s->s_next = 0.0f;
         s->k_next = -1;
+        s->xo = world_to_voxel(g, o);
+        s->xd = d * g.inv_spacing;
+        s->t_class = -UMBRA_INF;
+        s->class_b = 0;
         /* A ray that misses (or grazes) the box keeps an empty interval and its weight: lit. */
         s->ta = t.x;
         s->tb = (t.y > t.x && isfinite(t.x) && isfinite(t.y)) ? t.y : t.x;
@@ -401,22 +408,30 @@ inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
     return vp;
 }
 
-/* Whether position p lies in a visible sub-cell of its brick, whose cell mask is mask: cell j of
- * brick b covers the positions [b B + j C, b B + (j + 1) C) along each axis, C = ceil(B /
- * UMBRA_BRICK_CELLS), the border cells on to infinity (host/volume.c, compute_cells). */
-inline int deep_cell_visible(VolGeom g, ulong mask, float3 p)
+/* Where voxel position x lies for the empty-space test: 0 in a brick the light transfer function
+ * leaves empty, 1 in an invisible sub-cell of a non-empty brick, 2 in a visible sub-cell. Cell j
+ * of brick b covers the positions [b B + j C, b B + (j + 1) C) along each axis, C = ceil(B /
+ * UMBRA_BRICK_CELLS), the border cells on to infinity (host/volume.c, compute_cells). Located
+ * with the reciprocals of B and C (inv_B, inv_C) instead of divisions, last = (B - 1) / C
+ * given, and from the sub-ray in voxel coordinates: a point within rounding of a face may be
+ * counted to either side, as the threshold map's and CSSM's walks count theirs. Truncation stands
+ * for floor: they differ only below 0, which the clamp takes to 0 either way (and x lies in the
+ * box, far from the int range). This test is a fifth of a deep build's steps' work. */
+inline int deep_point_class(VolGeom g, __global const ulong *cells, float3 x, float inv_B,
+                            float inv_C, int last)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
-    const float3 x = world_to_voxel(g, p);
-    const int3 b = clamp(convert_int3(floor(x / (float)B)), (int3)(0), g.bricks - 1);
-    const int3 c = clamp(convert_int3(floor((x - convert_float3(b * B)) / (float)C)), (int3)(0),
-                         (int3)((B - 1) / C));
+    const int B = g.brick_size;
+    const int3 b = clamp(convert_int3(x * inv_B), (int3)(0), g.bricks - 1);
+    const ulong m = cells[(b.z * g.bricks.y + b.y) * g.bricks.x + b.x];
+    if (!m)
+        return 0;
+    const int3 c = clamp(convert_int3((x - convert_float3(b * B)) * inv_C), (int3)(0), (int3)(last));
     const int bit = (c.z * UMBRA_BRICK_CELLS + c.y) * UMBRA_BRICK_CELLS + c.x;
-    return (int)((mask >> bit) & 1UL);
+    return 1 + (int)((m >> bit) & 1UL);
 }
 
 /* The ray parameter at which o + t d leaves the sub-cell containing o + t_now d (cells as in
- * deep_cell_visible; brick_exit's for cells). */
+ * deep_point_class; brick_exit's for cells). */
 inline float deep_cell_exit(VolGeom g, float3 o, float3 d, float t_now)
 {
     const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
@@ -457,7 +472,10 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     const float h = S->step;
     const uint n_tf = F->light_tf_size, flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
-    const float t0 = T->base + (float)T->k * h, t1 = t0 + h;
+    /* t1 as the next segment's t0, not t0 + h: the two ends meet exactly (the class cache). */
+    const float t0 = T->base + (float)T->k * h, t1 = T->base + (float)(T->k + 1) * h;
+    const float inv_B = 1.0f / (float)g.brick_size, inv_C = 1.0f / (float)g.cell_size;
+    const int last_cell = (g.brick_size - 1) / g.cell_size;
 
     DeepPoints pts[DEEP_SUB_RAYS];
     light_t v_front[DEEP_SUB_RAYS]; /* each sub-ray's visibility at the segment's front end */
@@ -477,16 +495,23 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
         }
         const float3 pa = s->o + a * s->d, pb = s->o + b * s->d;
         if (skip) {
-            const int ba = brick_index(g, pa), bb = brick_index(g, pb);
-            const ulong ma = light_cells[ba], mb = light_cells[bb];
-            if (!ma && !mb) {
+            /* The front end's class is the previous segment's back end's when the two are the
+             * same point (t1 is computed as the next t0 is, so they are, segment after segment). */
+            const int ka = a == s->t_class ? s->class_b
+                                           : deep_point_class(g, light_cells, s->xo + a * s->xd,
+                                                              inv_B, inv_C, last_cell);
+            const int kb =
+                deep_point_class(g, light_cells, s->xo + b * s->xd, inv_B, inv_C, last_cell);
+            s->t_class = b;
+            s->class_b = kb;
+            if (ka == 0 && kb == 0) {
                 /* Both ends in bricks the light transfer function leaves empty: transparent,
                  * and (if every sub-ray is) the march may jump to the bricks' exits below. */
                 s->has_prev = 0;
                 v_end += s->w * s->v;
                 continue;
             }
-            if (!deep_cell_visible(g, ma, pa) && !deep_cell_visible(g, mb, pb)) {
+            if (ka < 2 && kb < 2) {
                 /* Both ends in sub-cells it leaves empty (kernels/umbra_shared.h): transparent
                  * too, as the threshold map's and CSSM's walks take them. Half the walnut's
                  * segments in non-empty bricks are, and each saved a sample, a table entry and a
@@ -504,9 +529,9 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
             float sf = s->has_prev ? s->s_prev : sample_volume(vol, g, pa);
             float sb = s->k_next == T->k ? s->s_next : sample_volume(vol, g, pb);
             /* The next segment's back end, sampled before this segment's table entry and fit so
-             * that its loads overlap them; at the position the next step computes (t1 there is
-             * its t0 + h), so the value is the one it would sample. */
-            const float t1_next = (T->base + (float)(T->k + 1) * h) + h;
+             * that its loads overlap them; at the position the next step computes (its t1), so
+             * the value is the one it would sample. */
+            const float t1_next = T->base + (float)(T->k + 2) * h;
             s->k_next = -1;
             if (t1_next <= s->tb) {
                 s->s_next = sample_volume(vol, g, s->o + t1_next * s->d);
