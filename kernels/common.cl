@@ -84,6 +84,22 @@ inline float umbra_random(uint seed, uint a, uint b, uint c)
     return (float)(h >> 8) * (1.0f / 16777216.0f);
 }
 
+/* floor(x) as integers, for |x| < 2^31: a conversion (truncation toward zero) and one less where
+ * that rounded up (x negative, not whole). PoCL's floor() is a dozen instructions, since it also
+ * handles huge and infinite values; in the sample and lookup loops that was a tenth of the
+ * unshadowed frame (issue #12). */
+inline int2 floor_int2(float2 x)
+{
+    const int2 i = convert_int2(x);
+    return i + (convert_float2(i) > x); /* a true vector comparison is -1 */
+}
+
+inline int3 floor_int3(float3 x)
+{
+    const int3 i = convert_int3(x);
+    return i + (convert_float3(i) > x);
+}
+
 /* Continuous voxel coordinates (voxel i's centre at i) of a world point. */
 inline float3 world_to_voxel(VolGeom g, float3 p)
 {
@@ -350,7 +366,8 @@ inline float4 to_light(__global const UmbraFrame *F, float3 p)
 #define UMBRA_POWER_BY_SQUARING 256.0f
 UMBRA_INLINE float shading_power(float x, float n)
 {
-    if (!(n == floor(n) && n <= UMBRA_POWER_BY_SQUARING))
+    /* n > 0 (the host checks it), so below the bound truncation tells a whole n */
+    if (!(n <= UMBRA_POWER_BY_SQUARING && n == (float)(int)n))
         return pow(x, n);
     uint e = (uint)n;
     float r = 1.0f;

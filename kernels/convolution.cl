@@ -142,9 +142,9 @@ inline light_t conv_fetch(__global const float *a, ConvCam c, float fx, float fy
     /* Far outside, every texel reads 1; clamping first keeps the int conversion defined. */
     fx = clamp(fx, (float)c.rect.x - 2.0f, (float)c.rect.z + 1.0f);
     fy = clamp(fy, (float)c.rect.y - 2.0f, (float)c.rect.w + 1.0f);
-    float x0 = floor(fx), y0 = floor(fy);
-    float tx = fx - x0, ty = fy - y0;
-    int ix = (int)x0, iy = (int)y0;
+    const int2 i0 = floor_int2((float2)(fx, fy));
+    const int ix = i0.x, iy = i0.y;
+    const float tx = fx - (float)ix, ty = fy - (float)iy;
     light_t t00, t10, t01, t11;
     if (ix >= c.rect.x && iy >= c.rect.y && ix + 1 < c.rect.z && iy + 1 < c.rect.w) {
         int i = iy * c.width + ix;

@@ -111,7 +111,7 @@ inline bool ls_base_texel(__global const UmbraShadow *S, float2 xy, int2 *texel)
     const float lim = 2.0f * (float)S->map_size + 64.0f;
     if (!(fabs(xy.x) < lim && fabs(xy.y) < lim))
         return false;
-    *texel = convert_int2(floor(xy));
+    *texel = floor_int2(xy);
     return true;
 }
 

@@ -169,9 +169,10 @@ UMBRA_INLINE float voxel_blended(VolGeom g, float b)
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
-    float3 fl = floor(x);
-    float3 f = x - fl;
-    int3 i0 = convert_int3(fl);
+    /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
+     * negative and huge values), a conversion one. */
+    int3 i0 = convert_int3(x);
+    float3 f = x - convert_float3(i0);
     int3 i1 = min(i0 + 1, g.dims - 1);
 #if UMBRA_VOLUME_SLABS == 1
     __global const UMBRA_VOXEL_T *restrict v = vol;
@@ -246,9 +247,8 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
     /* Clamped to one voxel past the border, where every difference is 0 either way, so the
      * integer conversion below stays defined for any p. */
     float3 x = clamp(world_to_voxel(g, p), (float3)(-1.0f), convert_float3(g.dims));
-    float3 fl = floor(x);
-    float3 f = x - fl;
-    int3 i = convert_int3(fl);
+    int3 i = floor_int3(x);
+    float3 f = x - convert_float3(i);
     int3 top = g.dims - 1;
     int3 a = clamp(i - 1, (int3)(0), top), b = clamp(i, (int3)(0), top);
     int3 c = clamp(i + 1, (int3)(0), top), d = clamp(i + 2, (int3)(0), top);
