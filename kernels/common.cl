@@ -100,6 +100,16 @@ inline int3 floor_int3(float3 x)
     return i + (convert_float3(i) > x);
 }
 
+/* |v| and v / |v| where they run per sample. PoCL's length() and normalize() guard against
+ * overflow and underflow by scaling, which costs several times the square root; the vectors here
+ * (gradients, offsets within the scene) are far from either, and the results were the same bit
+ * for bit on every image checked. Unshaded walnut camera orbit over the unshadowed frame with
+ * the map cached, old and new in turn: threshold 1.46x -> 1.42x, CSSM 1.66x -> 1.58x (issue
+ * #12). */
+inline float umbra_length(float3 v) { return sqrt(dot(v, v)); }
+
+inline float3 umbra_normalize(float3 v) { return v * (1.0f / sqrt(dot(v, v))); }
+
 /* Continuous voxel coordinates (voxel i's centre at i) of a world point. */
 inline float3 world_to_voxel(VolGeom g, float3 p)
 {
@@ -349,7 +359,7 @@ inline float4 to_light(__global const UmbraFrame *F, float3 p)
 {
     if (F->flags & UMBRA_FLAG_POINT_LIGHT) {
         float3 v = F3(F->light) - p;
-        float dist = length(v);
+        float dist = umbra_length(v);
         return dist > 0.0f ? (float4)(v / dist, dist) : (float4)(0.0f, 1.0f, 0.0f, 0.0f);
     }
     return (float4)(-F3(F->light), UMBRA_INF);

@@ -200,14 +200,14 @@ inline void conv_shade(__global const UmbraFrame *F, float3 c, float3 p, float3 
 {
     *amb = c * F3(F->ambient);
     float3 lc = F3(F->light_color);
-    float gl = length(grad);
+    float gl = umbra_length(grad);
     if (!(F->flags & UMBRA_FLAG_SHADING) || !(gl > 1e-6f)) {
         *coef = c * lc;
         return;
     }
     float3 n = -grad / gl;
     float3 l = to_light(F, p).xyz;
-    float3 hv = normalize(l + view);
+    float3 hv = umbra_normalize(l + view);
     float diff = fabs(dot(n, l));
     float spec = shading_power(fabs(dot(n, hv)), F->shininess);
     *coef = lc * (c * F->kd * diff + F->ks * spec);

@@ -40,7 +40,7 @@ UMBRA_INLINE float3 ls_world_to_map(__global const UmbraShadow *S, float3 p)
     } else {
         float3 q = p - F3(S->ls_origin);
         float3 l = (float3)(dot(q, u), dot(q, v), dot(q, w));
-        depth = length(q);
+        depth = umbra_length(q);
         if (S->ls_mode == UMBRA_LS_PERSPECTIVE)
             a = l.z > 0.0f ? l.xy / l.z : (float2)(-UMBRA_INF, -UMBRA_INF);
         else

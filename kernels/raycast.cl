@@ -30,14 +30,14 @@ UMBRA_INLINE float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 
     float3 amb = F3(F->ambient);
     if (!(F->flags & UMBRA_FLAG_SHADING))
         return c * (amb + light);
-    float gl = length(grad);
+    float gl = umbra_length(grad);
     if (!(gl > 1e-6f))
         return c * (amb + light);
     float3 n = grad * (-1.0f / gl);
     float3 l = l_ray, hv = hv_ray;
     if (F->flags & UMBRA_FLAG_POINT_LIGHT) {
         l = to_light(F, p).xyz;
-        hv = normalize(l + view);
+        hv = umbra_normalize(l + view);
     }
     float diff = fabs(dot(n, l));
     float spec = shading_power(fabs(dot(n, hv)), F->shininess);
