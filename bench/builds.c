@@ -5,8 +5,10 @@
  * For each scene (bench/scenes/walnut.scene and bonsai.scene by default) and map size (512 and
  * 1024 by default), six builds of the same light:
  *   threshold       the opacity-threshold map at its default threshold, 0.5: the baseline;
- *   threshold-0.99  the same march stopped where the deep map's march stops (visibility below
- *                   epsilon / 2 = 0.01, opacity 0.99): a threshold map that marches as far;
+ *   threshold-0.99  a threshold march as long as the deep map's: stopped where the deep map's
+ *                   march stops (visibility below epsilon / 2 = 0.01, opacity 0.99), at the deep
+ *                   map's light step of half a voxel (the threshold map's own is one voxel,
+ *                   host/lightspace.h);
  *   cssm-grey, cssm-colored   CSSM with grey and with coloured transmission (13 taps do not
  *                   enter a build);
  *   deep-grey, deep-colored   the deep map with a fixed budget of 3 nodes and epsilon 0.02.
@@ -168,6 +170,8 @@ static umbra_status renderer_for(umbra_context ctx, const umbra_scene *scene,
     sd.map_size = n;
     if (v->technique == UMBRA_SHADOW_THRESHOLD)
         sd.threshold = v->threshold;
+    if (v->technique == UMBRA_SHADOW_THRESHOLD && v->threshold > 0.5f)
+        sd.map_step = 0.5f; /* threshold-0.99: the deep map's step, so its march is as long */
     if (v->technique == UMBRA_SHADOW_DEEP)
         sd.max_nodes = 3; /* epsilon stays at its default, 0.02 */
     umbra_status st = umbra_renderer_create(ctx, out);
@@ -303,10 +307,11 @@ static int write_results(const options *o, int argc, char **argv, umbra_context 
                "each round; the build's own time (umbra_render_stats.shadow_build_ms) "
                "(bench/builds.c)\n\n",
             o->builds, o->warmup);
-    fprintf(f, "Build ms at equal map size and over the threshold map's. threshold-0.99 stops "
-               "where the deep map's march stops (visibility 0.01): the last column says how "
-               "much more a build costs than a threshold march of that length. The deep map has "
-               "3 nodes and epsilon 0.02.\n\n"
+    fprintf(f, "Build ms at equal map size and over the threshold map's (its light step is one "
+               "voxel, CSSM's too). threshold-0.99 stops where the deep map's march stops "
+               "(visibility 0.01), at the deep map's step of half a voxel: the last column says "
+               "how much more a build costs than a threshold march of that length. The deep map "
+               "has 3 nodes and epsilon 0.02.\n\n"
                "| scene | map | variant | build ms | over threshold | over threshold-0.99 |\n"
                "|---|---:|---|---:|---:|---:|\n");
     for (int i = 0; i < n; ++i)

@@ -64,7 +64,9 @@ static void usage(FILE *f)
         "                        voxel seen from the light, 64..2048; 0 is auto too)\n"
         "  --map-texels-per-voxel K   K for auto (default: threshold 1, cssm 3, deep 2; 1 is\n"
         "                        a draft while the light moves)\n"
-        "  --map-step S --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
+        "  --map-step S          light-ray step in voxels (default: threshold and cssm 1,\n"
+        "                        deep 0.5; 0 is the default too)\n"
+        "  --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
         "  --block-size K --prefilter 1|5 --no-lookup-table      light-space map parameters\n"
         "  --slice-distance S --subsamples N --preintegrated --cone-angle DEG  convolution\n");
 }

@@ -27,6 +27,11 @@ static void basis_from(const float w_in[3], float u[3], float v[3], float w[3])
     v[2] = w[0] * u[1] - w[1] * u[0];
 }
 
+float umbra__map_step(const umbra_shadow_desc *d, float own)
+{
+    return d->map_step > 0.0f ? d->map_step : own;
+}
+
 umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_desc *d,
                                         const char *name)
 {
@@ -41,10 +46,11 @@ umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_des
                            "%s: %s map_texels_per_voxel %g must be 0 (the technique's own) or lie "
                            "in [0.25, 8]",
                            fn, name, d->map_texels_per_voxel);
-    if (!(d->map_step >= 0.01f && d->map_step <= 64.0f))
+    if (!(d->map_step == 0.0f || (d->map_step >= 0.01f && d->map_step <= 64.0f)))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_step %g voxels must lie in [0.01, 64]", fn, name,
-                           d->map_step);
+                           "%s: %s map_step %g voxels must be 0 (the technique's own) or lie in "
+                           "[0.01, 64]",
+                           fn, name, d->map_step);
     return UMBRA_SUCCESS;
 }
 

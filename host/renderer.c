@@ -89,7 +89,7 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
     d->reference_step = 0.25f;
     d->map_size = UMBRA_MAP_SIZE_AUTO;
     d->map_texels_per_voxel = 0.0f;
-    d->map_step = 0.5f;
+    d->map_step = 0.0f; /* the technique's own (host/lightspace.h) */
     d->threshold = 0.5f;
     d->taps = 13;
     d->epsilon = 0.02f;

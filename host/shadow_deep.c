@@ -49,7 +49,10 @@ typedef struct deep_state {
     uint64_t builds, build_passes, lut_builds, pool_growths;
 } deep_state;
 
-static float deep_light_step(const umbra_shadow_desc *d) { return d->map_step; }
+static float deep_light_step(const umbra_shadow_desc *d)
+{
+    return umbra__map_step(d, UMBRA__MAP_STEP_DEEP);
+}
 
 static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
 {
@@ -205,7 +208,7 @@ static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    float step = r->shadow.map_step;
+    float step = deep_light_step(&r->shadow);
     uint32_t step_bits;
     memcpy(&step_bits, &step, sizeof step_bits);
     uint64_t key[4] = {umbra__light_tf(r)->id, step_bits, r->channels,
@@ -325,7 +328,7 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
         size_t global[2] = {(size_t)s->tiles_per_row * T, (size_t)s->tiles_per_row * T};
         size_t local[2] = {T, T};
         if ((st = umbra__run_2d(r, s->k_build, global, local,
-                                umbra__ray_samples(r, r->shadow.map_step) * r->shadow.prefilter,
+                                umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter,
                                 ms, "umbra_renderer_render")) != UMBRA_SUCCESS)
             return st;
         s->build_passes++;
@@ -373,7 +376,7 @@ static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
     UMBRA_CL(clSetKernelArg(s->k_fixed, next++, sizeof(cl_mem), &s->fixed));
     size_t global[2] = {n, n};
     st = umbra__run_2d(r, s->k_fixed, global, NULL,
-                       umbra__ray_samples(r, r->shadow.map_step) * r->shadow.prefilter, ms,
+                       umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter, ms,
                        "umbra_renderer_render");
     if (st == UMBRA_SUCCESS)
         s->build_passes++;

@@ -30,7 +30,10 @@ typedef struct map_kind {
 static const map_kind threshold_kind = {"threshold_build", 0};
 static const map_kind cssm_kind = {"cssm_build", 1};
 
-static float map_light_step(const umbra_shadow_desc *d) { return d->map_step; }
+static float map_light_step(const umbra_shadow_desc *d)
+{
+    return umbra__map_step(d, UMBRA__MAP_STEP_SURFACE);
+}
 
 static umbra_status map_validate(umbra_renderer r, const umbra_shadow_desc *d, const char *name)
 {
@@ -135,7 +138,7 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
     size_t global[2] = {n, n};
-    st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, d->map_step), ms,
+    st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, map_light_step(d)), ms,
                        "umbra_renderer_render");
 fail:
     return st;

@@ -851,7 +851,7 @@ static void test_bad_parameters(void **state)
         const char *needle;
     } bad[] = {
         {deep_desc(8, 0.5f, 0.02f, 1, 1, 0), "map_size 8"},
-        {deep_desc(64, 0.0f, 0.02f, 1, 1, 0), "map_step 0"},
+        {deep_desc(64, 0.001f, 0.02f, 1, 1, 0), "map_step 0.001"},
         {deep_desc(64, 0.5f, -0.1f, 1, 1, 0), "epsilon -0.1"},
         {deep_desc(64, 0.5f, NAN, 1, 1, 0), "epsilon nan"},
         {deep_desc(64, 0.5f, 0.02f, 1, 3, 0), "prefilter 3"},

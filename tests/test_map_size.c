@@ -348,6 +348,57 @@ static void test_texels_per_voxel_replaces_the_techniques_k(void **state)
     umbra_volume_release(v);
 }
 
+/* map_step 0, the default, is the technique's own light step: the same map and image as that
+ * step given explicitly (threshold and CSSM 1 voxel, deep 0.5), not those of another step. */
+static void test_map_step_default_is_the_techniques_own(void **state)
+{
+    umbra_context ctx = *state;
+    enum { W = 32, H = 24 };
+    umbra_volume v = make_volume(ctx, 40, 40, 40, NULL);
+    umbra_transfer_function tf = test_constant_tf(ctx, 1.0f, 0.05f);
+    umbra_light light = test_point_light(-30.0f, 50.0f, 20.0f);
+    umbra_renderer r = test_renderer(ctx, v, tf, NULL, &light, NULL);
+    float *a = malloc(W * H * 4 * sizeof *a), *b = malloc(W * H * 4 * sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    const struct {
+        umbra_shadow_technique t;
+        float own, other; /* the technique's step, and one whose image differs */
+    } cases[3] = {{UMBRA_SHADOW_THRESHOLD, 1.0f, 0.25f},
+                  {UMBRA_SHADOW_CSSM, 1.0f, 0.5f},
+                  {UMBRA_SHADOW_DEEP, 0.5f, 1.0f}};
+    umbra_shadow_desc s;
+    umbra_shadow_desc_init(&s);
+    assert_true(s.map_step == 0.0f);
+    umbra_render_stats st;
+    for (int i = 0; i < 3; ++i) {
+        s.technique = cases[i].t;
+        s.map_step = 0.0f;
+        render_sphere(r, s, W, H, a, &st);
+        s.map_step = cases[i].own;
+        render_sphere(r, s, W, H, b, &st);
+        assert_int_equal(st.shadow_rebuilt, 1);
+        assert_memory_equal(a, b, W * H * 4 * sizeof *a);
+        s.map_step = cases[i].other;
+        render_sphere(r, s, W, H, b, &st);
+        assert_true(memcmp(a, b, W * H * 4 * sizeof *a) != 0);
+    }
+    /* Outside 0 or [0.01, 64]: refused by name. */
+    const float bad[4] = {0.005f, -1.0f, 65.0f, NAN};
+    const char *said[4] = {"map_step 0.005 voxels must be 0", "map_step -1 voxels",
+                           "map_step 65 voxels", "map_step nan voxels"};
+    for (int i = 0; i < 4; ++i) {
+        s.map_step = bad[i];
+        assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
+        assert_true(test_message_contains(ctx, said[i]));
+    }
+    free(a);
+    free(b);
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(v);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -359,6 +410,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_auto_renders_as_the_same_explicit_size),
         cmocka_unit_test(test_explicit_sizes_kept_and_stats_report_them),
         cmocka_unit_test(test_texels_per_voxel_replaces_the_techniques_k),
+        cmocka_unit_test(test_map_step_default_is_the_techniques_own),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

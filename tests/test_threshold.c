@@ -176,6 +176,7 @@ static void test_threshold_light_transfer_function_drives_map(void **state)
     umbra_light l = test_directional_light(0, -1, 0);
     umbra_renderer r = test_renderer_transmission(ctx, vol, view, l, UMBRA_TRANSMISSION_GREY);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 1);
+    s.map_step = step; /* the bound below is this light step */
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     const float top[3] = {0.4f, 0.5f * MT_NY, 0.3f}, down[3] = {0, -1, 0};
     float flip = flip_distance(r, top, down, 31.0f, 0.02f, 1);
@@ -261,9 +262,9 @@ static void test_threshold_invalid_parameters_rejected(void **state)
     s.map_size = 16384;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
     s.map_size = 256;
-    s.map_step = 0.0f;
+    s.map_step = -0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
-    assert_true(test_message_contains(ctx, "map_step"));
+    assert_true(test_message_contains(ctx, "map_step -0.5"));
     s.map_step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     umbra_context_take_error(ctx, NULL);

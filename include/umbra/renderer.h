@@ -169,7 +169,9 @@ typedef struct umbra_shadow_desc {
                                     projection, 0 (the default: the technique's own, 1 threshold,
                                     3 CSSM, 2 deep; rule above) or [0.25, 8]; a fixed map_size
                                     ignores it */
-    float map_step;              /* light-ray step in voxels (default 0.5) */
+    float map_step;              /* light-ray step in voxels: 0 (the default: the technique's
+                                    own, 1 for the threshold map and CSSM, 0.5 for the deep
+                                    map, README "Map size") or [0.01, 64] */
     float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
                                     a texel's depth is stored (default 0.5); one grey depth per
                                     texel, map_size^2 * 4 bytes. Everything behind that depth is

@@ -183,7 +183,8 @@ void bind_options(nb::module_ &m)
           "light-space maps at MAP_SIZE_AUTO: texels per voxel, 0 (the technique's own: "
           "threshold 1, cssm 3, deep 2) or 0.25..8; 1 is a draft while the light moves");
     field(so, "map_step", &umbra_shadow_desc::map_step,
-          "light-space maps: light-ray step in voxels");
+          "light-space maps: light-ray step in voxels, 0 (the technique's own, the default: "
+          "threshold 1, cssm 1, deep 0.5) or 0.01..64");
     field(so, "threshold", &umbra_shadow_desc::threshold,
           "threshold map: accumulated light opacity in (0, 1) at which the depth is stored");
     field(so, "taps", &umbra_shadow_desc::taps,
