@@ -416,7 +416,9 @@ inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
  * given, and from the sub-ray in voxel coordinates: a point within rounding of a face may be
  * counted to either side, as the threshold map's and CSSM's walks count theirs. Truncation stands
  * for floor: they differ only below 0, which the clamp takes to 0 either way (and x lies in the
- * box, far from the int range). This test is a fifth of a deep build's steps' work. */
+ * box, far from the int range). In its earlier form (a division and floor() per axis, and both
+ * ends located afresh every step) the test took about a fifth of a deep build in a profile;
+ * this one and the cache in deep_step made builds 0.80x-0.88x (issue #12). */
 inline int deep_point_class(VolGeom g, __global const ulong *cells, float3 x, float inv_B,
                             float inv_C, int last)
 {
