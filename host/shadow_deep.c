@@ -54,6 +54,12 @@ static float deep_light_step(const umbra_shadow_desc *d)
     return umbra__map_step(d, UMBRA__MAP_STEP_DEEP);
 }
 
+/* Samples a texel's march takes, at most: the cost of a build launch (progress bands). */
+static double march_cost(umbra_renderer r)
+{
+    return umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter;
+}
+
 static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
 {
     const char *fn = "umbra_renderer_set_shadow";
@@ -327,9 +333,8 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof limit, &limit));
         size_t global[2] = {(size_t)s->tiles_per_row * T, (size_t)s->tiles_per_row * T};
         size_t local[2] = {T, T};
-        if ((st = umbra__run_2d(r, s->k_build, global, local,
-                                umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter,
-                                ms, "umbra_renderer_render")) != UMBRA_SUCCESS)
+        if ((st = umbra__run_2d(r, s->k_build, global, local, march_cost(r), ms,
+                                "umbra_renderer_render")) != UMBRA_SUCCESS)
             return st;
         s->build_passes++;
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, s->counter, CL_TRUE, 0, sizeof used, &used, 0,
@@ -375,9 +380,7 @@ static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
         return st;
     UMBRA_CL(clSetKernelArg(s->k_fixed, next++, sizeof(cl_mem), &s->fixed));
     size_t global[2] = {n, n};
-    st = umbra__run_2d(r, s->k_fixed, global, NULL,
-                       umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter, ms,
-                       "umbra_renderer_render");
+    st = umbra__run_2d(r, s->k_fixed, global, NULL, march_cost(r), ms, "umbra_renderer_render");
     if (st == UMBRA_SUCCESS)
         s->build_passes++;
 fail:

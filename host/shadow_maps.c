@@ -138,8 +138,8 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
     size_t global[2] = {n, n};
-    st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, map_light_step(d)), ms,
-                       "umbra_renderer_render");
+    st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, map_light_step(d)),
+                       ms, "umbra_renderer_render");
 fail:
     return st;
 }

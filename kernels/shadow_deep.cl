@@ -427,7 +427,8 @@ inline int deep_point_class(VolGeom g, __global const ulong *cells, float3 x, fl
     const ulong m = cells[(b.z * g.bricks.y + b.y) * g.bricks.x + b.x];
     if (!m)
         return 0;
-    const int3 c = clamp(convert_int3((x - convert_float3(b * B)) * inv_C), (int3)(0), (int3)(last));
+    const int3 c =
+        clamp(convert_int3((x - convert_float3(b * B)) * inv_C), (int3)(0), (int3)(last));
     const int bit = (c.z * UMBRA_BRICK_CELLS + c.y) * UMBRA_BRICK_CELLS + c.x;
     return 1 + (int)((m >> bit) & 1UL);
 }
