@@ -68,6 +68,8 @@ static void usage(FILE *f)
         "                        deep 0.5; 0 is the default too)\n"
         "  --threshold T --taps 1|7|13|21 --epsilon E --nodes N\n"
         "  --block-size K --prefilter 1|5 --no-lookup-table      light-space map parameters\n"
+        "  --ray-block B         cssm: photons of B x B texels share a light ray (default:\n"
+        "                        the map's texels per voxel, at most 3; 1: a ray per texel)\n"
         "  --slice-distance S --subsamples N --preintegrated --cone-angle DEG  convolution\n");
 }
 
@@ -369,6 +371,7 @@ static int parse_args(int argc, char **argv, options *o)
         else if (FLAG("--map-step")) { NEED(); if (!parse_floats(v, &o->shadow.map_step, 1)) BAD("--map-step '%s' is not a number", v); }
         else if (FLAG("--threshold")) { NEED(); if (!parse_floats(v, &o->shadow.threshold, 1)) BAD("--threshold '%s' is not a number", v); }
         else if (FLAG("--taps")) { NEED(); if (!parse_uint(v, &o->shadow.taps)) BAD("--taps '%s' is not a whole number", v); }
+        else if (FLAG("--ray-block")) { NEED(); if (!parse_uint(v, &o->shadow.ray_block)) BAD("--ray-block '%s' is not a whole number", v); }
         else if (FLAG("--epsilon")) { NEED(); if (!parse_floats(v, &o->shadow.epsilon, 1)) BAD("--epsilon '%s' is not a number", v); }
         else if (FLAG("--nodes")) { NEED(); if (!parse_uint(v, &o->shadow.max_nodes)) BAD("--nodes '%s' is not a whole number", v); }
         else if (FLAG("--block-size")) { NEED(); if (!parse_uint(v, &o->shadow.block_size)) BAD("--block-size '%s' is not a whole number", v); }

@@ -69,22 +69,28 @@ static double texels_per_voxel(umbra_renderer r)
     return t == UMBRA_SHADOW_CSSM ? 3.0 : t == UMBRA_SHADOW_DEEP ? 2.0 : 1.0;
 }
 
-/* UMBRA_MAP_SIZE_AUTO: texels_per_voxel(r) per voxel of the box as the light sees it. extent is the
- * wider side of the map's window in its own units (world units for an orthographic map, tangents
- * for a perspective one), scale the world length one window unit stands for at the box (1 for
- * orthographic, the distance to the box's centre for a perspective frustum); an octahedral map
- * covers the sphere of directions, 4 pi steradians over its n^2 texels, and a voxel at distance R
- * subtends (voxel / R)^2 of it, so n = sqrt(4 pi) R / voxel with R the distance to the farthest
- * corner (every voxel at most that far gets its share). Rounded up to a multiple of
- * UMBRA_MAP_SIZE_AUTO_ROUND: the deep map's tiles are 8 or 16 texels, so whole tiles and full
- * 8 x 8 work-groups; bounded to [MIN, MAX]. Computed in double: a world of 1e18 units must not
- * overflow before the bounds apply. */
-static uint32_t auto_map_size(umbra_renderer r, int mode, double extent, double scale, double far)
+/* Voxels across the map: how many voxels of the box the map's window spans as the light sees it,
+ * so that texels_per_voxel(r) times it is UMBRA_MAP_SIZE_AUTO's size (before rounding). extent is
+ * the wider side of the map's window in its own units (world units for an orthographic map,
+ * tangents for a perspective one), scale the world length one window unit stands for at the box
+ * (1 for orthographic, the distance to the box's centre for a perspective frustum); an
+ * octahedral map covers the sphere of directions, 4 pi steradians over its n^2 texels, and a
+ * voxel at distance R subtends (voxel / R)^2 of it, so n = sqrt(4 pi) R / voxel with R the
+ * distance to the farthest corner (every voxel at most that far gets its share). In double: a
+ * world of 1e18 units must not overflow. */
+static double voxels_across(umbra_renderer r, int mode, double extent, double scale, double far)
 {
     double voxel = umbra__voxel_world(r);
-    double n = texels_per_voxel(r) *
-               (mode == UMBRA_LS_OCTAHEDRAL ? sqrt(4.0 * 3.14159265358979) * far / voxel
-                                            : extent * scale / voxel);
+    return mode == UMBRA_LS_OCTAHEDRAL ? sqrt(4.0 * 3.14159265358979) * far / voxel
+                                       : extent * scale / voxel;
+}
+
+/* UMBRA_MAP_SIZE_AUTO: texels_per_voxel(r) per voxel across, rounded up to a multiple of
+ * UMBRA_MAP_SIZE_AUTO_ROUND (the deep map's tiles are 8 or 16 texels, so whole tiles and full
+ * 8 x 8 work-groups) and bounded to [MIN, MAX]. */
+static uint32_t auto_map_size(umbra_renderer r, double across)
+{
+    double n = texels_per_voxel(r) * across;
     if (!(n >= UMBRA_MAP_SIZE_AUTO_MIN)) /* NaN too */
         return UMBRA_MAP_SIZE_AUTO_MIN;
     if (n >= UMBRA_MAP_SIZE_AUTO_MAX)
@@ -101,7 +107,7 @@ static void set4(float d[4], const float s[3], float w)
     d[3] = w;
 }
 
-void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
+double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
 {
     UmbraShadow *S = &r->shadow_params;
     const UmbraFrame *F = &r->frame;
@@ -173,10 +179,11 @@ void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
             hi[0] = hi[1] = 1.0f;
         }
     }
+    const double across =
+        voxels_across(r, (int)S->ls_mode, fmax((double)hi[0] - lo[0], (double)hi[1] - lo[1]),
+                      S->ls_mode == UMBRA_LS_PERSPECTIVE ? dist_centre : 1.0, hi[2]);
     if (map_size == UMBRA_MAP_SIZE_AUTO)
-        map_size = auto_map_size(r, (int)S->ls_mode,
-                                 fmax((double)hi[0] - lo[0], (double)hi[1] - lo[1]),
-                                 S->ls_mode == UMBRA_LS_PERSPECTIVE ? dist_centre : 1.0, hi[2]);
+        map_size = auto_map_size(r, across);
     S->map_size = map_size;
     r->stats.map_size = map_size;
     /* Half a texel of margin so that bilinear taps at the rim still see the box. */
@@ -200,4 +207,5 @@ void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
     S->near_far[1] = hi[2];
     S->near_far[2] = 1.0f / (hi[2] - lo[2]);
     S->near_far[3] = 0.0f;
+    return across > 0.0 ? (double)map_size / across : INFINITY; /* a box of no extent: NaN */
 }

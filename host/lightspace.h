@@ -14,7 +14,7 @@
  * normalised to [0,1] between the box's nearest and farthest points along the light. map_size
  * UMBRA_MAP_SIZE_AUTO chooses the size from the box's footprint as the light sees it (the rule is
  * in include/umbra/renderer.h); S->map_size holds the size used, which the builds must read. */
-void umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
+double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
 /* The light step of a light-space map in voxels: desc->map_step where set, else (0, the default)
  * the technique's own, own. The threshold map and CSSM take one voxel

@@ -98,6 +98,7 @@ void umbra_shadow_desc_init(umbra_shadow_desc *d)
     d->prefilter = 1;
     d->lookup_table = 1;
     d->seed = 1;
+    d->ray_block = 0; /* as many texels per side as fit in a voxel of the map, at most 3 */
     d->slice_distance = 0.5f;
     d->subsamples = 0;
     d->preintegrated = 0;

@@ -30,6 +30,15 @@ typedef struct map_kind {
 static const map_kind threshold_kind = {"threshold_build", 0};
 static const map_kind cssm_kind = {"cssm_build", 1};
 
+/* The CSSM block whose photons share a light ray (kernels/shadow_cssm.cl), B x B texels: by
+ * default B is the map's whole texels per voxel, at most UMBRA_CSSM_MAX_RAY_BLOCK, so that a
+ * block never spans more than a voxel of the box as the light sees it. */
+static uint32_t cssm_ray_block(double texels_per_voxel)
+{
+    const double b = floor(fmin(texels_per_voxel, UMBRA_CSSM_MAX_RAY_BLOCK));
+    return b >= 1.0 ? (uint32_t)b : 1u; /* NaN too */
+}
+
 static float map_light_step(const umbra_shadow_desc *d)
 {
     return umbra__map_step(d, UMBRA__MAP_STEP_SURFACE);
@@ -58,6 +67,11 @@ static umbra_status threshold_validate(umbra_renderer r, const umbra_shadow_desc
 
 static umbra_status cssm_validate(umbra_renderer r, const umbra_shadow_desc *d)
 {
+    if (d->ray_block > UMBRA_CSSM_MAX_RAY_BLOCK)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_set_shadow: cssm ray_block %u must be 0 (the map's "
+                           "own) or lie in [1, %d]",
+                           d->ray_block, UMBRA_CSSM_MAX_RAY_BLOCK);
     return map_validate(r, d, "cssm");
 }
 
@@ -80,8 +94,11 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
     }
     const umbra_shadow_desc *d = &r->shadow;
     UmbraShadow *S = &r->shadow_params;
-    umbra__lightspace_setup(r, d->map_size);
+    const double texels_per_voxel = umbra__lightspace_setup(r, d->map_size);
     const uint32_t n = S->map_size; /* the size chosen, when d->map_size is auto */
+    S->ray_block = !kind->per_channel ? 1u
+                   : d->ray_block   ? d->ray_block
+                                    : cssm_ray_block(texels_per_voxel);
     S->threshold = d->threshold;
     S->taps = d->taps;
     S->seed = d->seed;
@@ -137,7 +154,8 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
     if ((st = umbra__bind_common(r, s->build_kernel, &next)) != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
-    size_t global[2] = {n, n};
+    const size_t blocks = (n + S->ray_block - 1) / S->ray_block;
+    size_t global[2] = {blocks, blocks};
     st = umbra__run_2d(r, s->build_kernel, global, NULL, umbra__ray_samples(r, map_light_step(d)),
                        ms, "umbra_renderer_render");
 fail:

@@ -68,6 +68,10 @@ typedef struct UmbraFrame {
 #define UMBRA_LS_PERSPECTIVE 1u /* point light outside the box: a frustum around it */
 #define UMBRA_LS_OCTAHEDRAL 2u  /* point light at, inside or very near the box: every direction */
 
+/* CSSM: the largest block side whose photons share a light ray (the kernel's arrays hold the
+ * square of it; the host refuses more). */
+#define UMBRA_CSSM_MAX_RAY_BLOCK 3
+
 /* Per-technique shadow parameters. One struct for all techniques keeps the ray caster's
  * signature fixed; each technique uses the fields it documents. The ls_* fields describe the
  * light-space map (host/lightspace.c fills them, kernels/lightspace.cl reads them). */
@@ -91,7 +95,8 @@ typedef struct UmbraShadow {
     float depth_bias;         /* threshold / CSSM: normalised depth a sample must lie beyond a
                                  stored depth to be shadowed by it */
     uint32_t deep_tile;       /* deep map: tile edge in texels (16, or 8 on small work-groups) */
-    uint32_t pad[11];         /* room for technique fields without changing the size */
+    uint32_t ray_block;       /* CSSM: texels per side of a block whose photons share a ray */
+    uint32_t pad[10];         /* room for technique fields without changing the size */
 } UmbraShadow;
 
 #endif

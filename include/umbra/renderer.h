@@ -197,6 +197,12 @@ typedef struct umbra_shadow_desc {
                                     the same device. The map holds one depth per simulated light
                                     channel (3, or 1 for a grey light): map_size^2 * 12 or 4
                                     bytes */
+    uint32_t ray_block;          /* CSSM: texels per side of the square blocks whose photons
+                                    share one light ray (through the block's centre; each photon
+                                    keeps its own random number): 0 (the default: the map's
+                                    whole texels per voxel, at most 3, so that a block spans no
+                                    more than a voxel), 1 (a ray per texel, as in the paper), 2
+                                    or 3; README "Colored stochastic shadow maps" */
     /* convolution: the technique renders the frame itself with view-aligned slices (ICS). The
      * light must come from the viewer's side: a directional light within 80 degrees of the view
      * direction, a point light from which every corner of the box lies within 80 degrees of it;

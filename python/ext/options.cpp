@@ -200,6 +200,8 @@ void bind_options(nb::module_ &m)
     flag(so, "lookup_table", &umbra_shadow_desc::lookup_table,
          "deep map: use the pre-compressed segment table");
     field(so, "seed", &umbra_shadow_desc::seed, "CSSM: seed of the random numbers");
+    field(so, "ray_block", &umbra_shadow_desc::ray_block,
+          "CSSM: texels per side whose photons share a light ray, 0 (the map's own) or 1..3");
     field(so, "slice_distance", &umbra_shadow_desc::slice_distance,
           "convolution: voxels between slices, [0.02, 16]");
     field(so, "subsamples", &umbra_shadow_desc::subsamples,

@@ -101,6 +101,8 @@ def test_bad_options_name_the_value(ctx):
             r.set_shadow(technique="deep", map_size=8)
         with raises_invalid(r"map_texels_per_voxel 9 must be 0 .* or lie in \[0.25, 8\]"):
             r.set_shadow(technique="cssm", map_texels_per_voxel=9)
+        with raises_invalid(r"cssm ray_block 4 must be 0 \(the map's own\) or lie in \[1, 3\]"):
+            r.set_shadow(technique="cssm", ray_block=4)
         with pytest.raises(TypeError, match="unknown parameter 'mapsize'.*map_size"):
             r.render(8, 8, technique="deep", mapsize=64)
         with pytest.raises(TypeError, match=r"taps=-1 is not a valid int"):

@@ -86,9 +86,10 @@ def test_every_technique_renders_and_shadows(ctx, spheres):
 
 def test_technique_parameters_reach_the_renderer(ctx, spheres):
     with spheres.renderer() as r:
-        r.set_shadow(technique="cssm", map_size=128, taps=7, seed=3)
+        r.set_shadow(technique="cssm", map_size=128, taps=7, seed=3, ray_block=1)
         assert r.shadow.technique == umbra.Technique.CSSM
         assert (r.shadow.map_size, r.shadow.taps, r.shadow.seed) == (128, 7, 3)
+        assert r.shadow.ray_block == 1
         r.render(32, 24)
         small = r.stats.shadow_memory_bytes
         r.set_shadow(technique=umbra.Technique.CSSM, map_size=256)
@@ -97,6 +98,7 @@ def test_technique_parameters_reach_the_renderer(ctx, spheres):
         assert r.stats.map_size == 256
         # parameters not given take the C defaults again, not the previous values
         assert r.shadow.taps == umbra.ShadowOptions().taps
+        assert r.shadow.ray_block == 0
 
 
 def test_map_size_auto_is_the_default_and_reported(ctx, spheres):
