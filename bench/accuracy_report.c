@@ -522,7 +522,7 @@ static const result *find_run(const bench_run *B, int si, umbra_shadow_technique
             continue;
         if (t == UMBRA_SHADOW_THRESHOLD && (d->taps != taps || d->threshold != 0.5f))
             continue;
-        if (t == UMBRA_SHADOW_CSSM && d->taps != taps)
+        if (t == UMBRA_SHADOW_CSSM && (d->taps != taps || d->ray_block != 0))
             continue;
         if (t == UMBRA_SHADOW_DEEP &&
             (d->epsilon != eps || d->max_nodes != nodes || d->prefilter != prefilter))
