@@ -35,8 +35,10 @@ static const map_kind cssm_kind = {"cssm_build", 1};
  * block never spans more than a voxel of the box as the light sees it. */
 static uint32_t cssm_ray_block(double texels_per_voxel)
 {
-    const double b = floor(fmin(texels_per_voxel, UMBRA_CSSM_MAX_RAY_BLOCK));
-    return b >= 1.0 ? (uint32_t)b : 1u; /* NaN too */
+    if (!(texels_per_voxel >= 1.0)) /* NaN too */
+        return 1u;
+    return texels_per_voxel >= UMBRA_CSSM_MAX_RAY_BLOCK ? UMBRA_CSSM_MAX_RAY_BLOCK
+                                                        : (uint32_t)texels_per_voxel;
 }
 
 static float map_light_step(const umbra_shadow_desc *d)
