@@ -28,10 +28,10 @@
  *    host's default B is the map's whole texels per voxel, at most 3, so that the rays a block
  *    stands for would cross the same voxels: at auto sizes (3 texels per voxel) that is a ninth
  *    of the rays, each marched until the deepest of nine photons stops. Measured with umbra-bench
- *    accuracy on all seven bench scenes, against a ray per texel and a number per segment: RMSE
- *    0.98x-1.03x, builds 0.2x-0.5x where blocks of 3 x 3 apply (README, "Colored stochastic
- *    shadow map"). The taps of a lookup (radius >= 4 texels) fall in other blocks, so the
- *    average still draws on 13 rays.
+ *    accuracy on all seven bench scenes, against a ray per texel (ray_block 1) in the same run:
+ *    RMSE 1.00x-1.01x, builds 0.18x-0.40x at auto and 1024^2 (README, "Colored stochastic shadow
+ *    map"). The taps of a lookup (radius >= 4 texels) fall in other blocks, so the average still
+ *    draws on 13 rays.
  *
  * Segments: whole steps of S->step plus one partial step, sampled at their midpoints, each with
  * the optical depth of its length, so the product of the (1 - rho_i) along a whole ray is the
