@@ -207,5 +207,5 @@ double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size)
     S->near_far[1] = hi[2];
     S->near_far[2] = 1.0f / (hi[2] - lo[2]);
     S->near_far[3] = 0.0f;
-    return across > 0.0 ? (double)map_size / across : INFINITY; /* a box of no extent: NaN */
+    return across > 0.0 ? (double)map_size / across : INFINITY; /* across 0 or NaN: no extent */
 }

@@ -13,7 +13,9 @@
  * box an octahedral map over all directions, so no light position is singular. Depth is
  * normalised to [0,1] between the box's nearest and farthest points along the light. map_size
  * UMBRA_MAP_SIZE_AUTO chooses the size from the box's footprint as the light sees it (the rule is
- * in include/umbra/renderer.h); S->map_size holds the size used, which the builds must read. */
+ * in include/umbra/renderer.h); S->map_size holds the size used, which the builds must read.
+ * Returns the map's texels per voxel of the box as the light sees it (CSSM's ray block follows
+ * it; infinite for a box of no extent). */
 double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
 /* The light step of a light-space map in voxels: desc->map_step where set, else (0, the default)

@@ -202,7 +202,7 @@ typedef struct umbra_shadow_desc {
                                     keeps its own random number): 0 (the default: the map's
                                     whole texels per voxel, at most 3, so that a block spans no
                                     more than a voxel), 1 (a ray per texel, as in the paper), 2
-                                    or 3; README "Colored stochastic shadow maps" */
+                                    or 3; README "Colored stochastic shadow map" */
     /* convolution: the technique renders the frame itself with view-aligned slices (ICS). The
      * light must come from the viewer's side: a directional light within 80 degrees of the view
      * direction, a point light from which every corner of the box lies within 80 degrees of it;
