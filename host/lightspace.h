@@ -19,7 +19,7 @@
 double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
 /* The light step of a light-space map in voxels: desc->map_step where set, else (0, the default)
- * the technique's own, own. The threshold map and CSSM take one voxel
+ * `own`, the technique's own step. The threshold map and CSSM take one voxel
  * (UMBRA__MAP_STEP_SURFACE), the deep map half a voxel (UMBRA__MAP_STEP_DEEP). Measured with
  * umbra-bench accuracy at auto map sizes on all seven bench scenes (issue #12): a step of 1
  * instead of 0.5 left the threshold map's RMSE at most 0.2% higher (3% lower on the spheres and

@@ -417,7 +417,6 @@ inline float tf_extinction(float a) { return -log1p(-fmin(a, UMBRA_ALPHA_MAX)); 
 
 #if UMBRA_LIGHT_CHANNELS == 1
 typedef float light_t;
-/* Optical depth of len voxels of light transfer-function colour c, per light channel. */
 /* The fraction 1 - t of the extinction that light transfer-function colour c applies. */
 inline light_t light_absorbed(float4 c, uint flags)
 {
@@ -426,6 +425,7 @@ inline light_t light_absorbed(float4 c, uint flags)
 inline float3 light_rgb(light_t v) { return (float3)(v); }
 inline float light_max(light_t v) { return v; }
 inline float light_min(light_t v) { return v; }
+inline int light_any_gt(light_t a, light_t b) { return a > b; } /* in any channel */
 #else
 typedef float3 light_t;
 inline light_t light_absorbed(float4 c, uint flags)
@@ -435,6 +435,7 @@ inline light_t light_absorbed(float4 c, uint flags)
 inline float3 light_rgb(light_t v) { return v; }
 inline float light_max(light_t v) { return fmax(v.x, fmax(v.y, v.z)); }
 inline float light_min(light_t v) { return fmin(v.x, fmin(v.y, v.z)); }
+inline int light_any_gt(light_t a, light_t b) { return any(a > b); }
 #endif
 
 /* Optical depth of len voxels of light transfer-function colour c, per light channel. */

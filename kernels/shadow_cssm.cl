@@ -57,20 +57,17 @@ typedef struct ShadowRay {
 inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
 /* A texel's depths (one per light channel) in the map, and per channel c of a light_t (c a
- * constant in the unrolled loops below) the value, a light_t of an array's values, and whether
- * any channel of a exceeds b's. */
+ * constant in the unrolled loops below) the value, and a light_t of an array's values. */
 #if UMBRA_LIGHT_CHANNELS == 1
 #define CSSM_STORE(v, i, map) ((map)[i] = (v))
 #define CSSM_LOAD(i, map) ((map)[i])
 #define LIGHT_CH(v, c) (v)
 #define LIGHT_FROM(a) ((a)[0])
-#define LIGHT_ANY_GT(a, b) ((a) > (b))
 #else
 #define CSSM_STORE(v, i, map) vstore3((v), (i), (map))
 #define CSSM_LOAD(i, map) vload3((i), (map))
 #define LIGHT_CH(v, c) ((c) == 0 ? (v).x : (c) == 1 ? (v).y : (v).z)
 #define LIGHT_FROM(a) ((float3)((a)[0], (a)[1], (a)[2]))
-#define LIGHT_ANY_GT(a, b) any((a) > (b))
 #endif
 
 /* light_depth (kernels/common.cl) without its library call: the march needs a segment's optical
@@ -164,7 +161,7 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, o + t_mid * d));
             if (col.w > 0.0f) {
                 tau += cssm_depth(col, h_vox * (seg / h), flags);
-                if (LIGHT_ANY_GT(tau, e_next)) {
+                if (light_any_gt(tau, e_next)) {
                     const float zk = ls_depth(S, o, t_mid);
                     float en[UMBRA_LIGHT_CHANNELS];
                     for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {

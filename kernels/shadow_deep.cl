@@ -65,7 +65,6 @@ typedef float2 deep_node;
 #define DEEP_DEPTH(n) ((n).x)
 #define DEEP_VIS(n) ((n).y)
 #define DEEP_NODE(z, v) ((float2)((z), (v)))
-inline int deep_any_gt(float a, float b) { return a > b; }
 inline int deep_all_one(float v) { return v >= 1.0f; }
 inline float deep_max_abs(float v) { return fabs(v); }
 #else
@@ -73,7 +72,6 @@ typedef float4 deep_node;
 #define DEEP_DEPTH(n) ((n).x)
 #define DEEP_VIS(n) ((n).yzw)
 #define DEEP_NODE(z, v) ((float4)((z), (v)))
-inline int deep_any_gt(float3 a, float3 b) { return any(a > b); }
 inline int deep_all_one(float3 v) { return all(v >= (float3)(1.0f)); }
 inline float deep_max_abs(float3 v) { return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z))); }
 #endif
@@ -159,7 +157,7 @@ inline void deep_fit_feed(DeepFit *f, float z, light_t v, float tol, deep_node *
         /* The segment ends at the previous point when no slope keeps every point within tol, or
          * when none of those reaches up to this point (its node would lie below it). */
         light_t nlo = fmax(lo, f->lo), nhi = fmin(hi, f->hi);
-        if (deep_any_gt(nlo, nhi) || deep_any_gt((v - f->v0) / dz, nhi)) {
+        if (light_any_gt(nlo, nhi) || light_any_gt((v - f->v0) / dz, nhi)) {
             deep_node c = deep_fit_close(f);
             e[(*n)++] = c;
             f->z0 = DEEP_DEPTH(c);
