@@ -502,6 +502,27 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     return UMBRA_SUCCESS;
 }
 
+/* The ray caster's work-group: 32 x 8 work-items where the kernel and device allow 256, else
+ * 8 x 8. PoCL compiles a work-group function for each local size, and on this machine's CPU the
+ * one for 64 work-items rendered the same frames 1.3x-1.9x slower than the one for 256 with
+ * 16-bit and float volumes (walnut, carp, spheres; the time went into the kernel, not the
+ * runtime), and as fast with 8-bit ones (bonsai, foot). The shape did not matter (32 x 8, 8 x 32
+ * and 256 x 1 alike; 16 x 4 and 64 x 1 as slow as 8 x 8). Issue #12. */
+static void choose_render_local(umbra_renderer r)
+{
+    size_t kernel_wg = 0, device_wg = 0, items[3] = {0, 0, 0};
+    r->render_local[0] = r->render_local[1] = 8;
+    if (clGetKernelWorkGroupInfo(r->render_kernel, r->ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
+                                 sizeof kernel_wg, &kernel_wg, NULL) != CL_SUCCESS ||
+        clGetDeviceInfo(r->ctx->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof device_wg,
+                        &device_wg, NULL) != CL_SUCCESS ||
+        clGetDeviceInfo(r->ctx->device, CL_DEVICE_MAX_WORK_ITEM_SIZES, sizeof items, items,
+                        NULL) != CL_SUCCESS)
+        return; /* 8 x 8, as every kernel of the library may assume */
+    if (kernel_wg >= 256 && device_wg >= 256 && items[0] >= 32 && items[1] >= 8)
+        r->render_local[0] = 32;
+}
+
 static umbra_status ensure_kernels(umbra_renderer r)
 {
     char options[256];
@@ -521,6 +542,7 @@ static umbra_status ensure_kernels(umbra_renderer r)
         release_kernels(r);
         return st;
     }
+    choose_render_local(r);
     r->program = program;
     return UMBRA_SUCCESS;
 }
@@ -603,14 +625,14 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
                                  0, NULL, NULL));
     if (r->async) {
         /* An asynchronous frame is one launch, not waited for: no bands, no progress. */
-        st = umbra__enqueue(ctx, r->render_kernel, 2, global, NULL, &ev);
+        st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev);
         r->stats.render_ms = 0.0;
         r->stats.samples = 0;
         goto fail; /* done or failed: the caller marks the frame's end */
     }
     double ms = 0.0;
-    st = umbra__run_2d(r, r->render_kernel, global, NULL, umbra__ray_samples(r, r->opts.step),
-                       &ms, fn);
+    st = umbra__run_2d(r, r->render_kernel, global, r->render_local,
+                       umbra__ray_samples(r, r->opts.step), &ms, fn);
     if (st != UMBRA_SUCCESS)
         goto fail;
     r->stats.render_ms = ms;

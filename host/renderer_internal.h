@@ -92,6 +92,7 @@ struct umbra_renderer_t {
     size_t out_bytes;
     cl_program program;                      /* the ray caster + technique program in use */
     cl_kernel render_kernel, query_kernel;
+    size_t render_local[2];                  /* raycast_render's work-group (ensure_kernels) */
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
     /* The view and light transfer functions as the volume's normalised range sees them
      * (umbra__tf_for_volume: the set ones, or resampled from their data range), and the
