@@ -504,10 +504,12 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
 
 /* The ray caster's work-group: 32 x 8 work-items where the kernel and device allow 256, else
  * 8 x 8. PoCL compiles a work-group function for each local size, and on this machine's CPU the
- * one for 64 work-items rendered the same frames 1.3x-1.9x slower than the one for 256 with
- * 16-bit and float volumes (walnut, carp, spheres; the time went into the kernel, not the
- * runtime), and as fast with 8-bit ones (bonsai, foot). The shape did not matter (32 x 8, 8 x 32
- * and 256 x 1 alike; 16 x 4 and 64 x 1 as slow as 8 x 8). Issue #12. */
+ * one for 64 work-items rendered the same frames 1.3x-1.9x slower than the one for 256 on the
+ * walnut and the carp (16-bit) and the spheres (float; the time went into the kernel, not the
+ * runtime), and as fast on the bonsai and the foot (8-bit) and the Marschner-Lobb volume
+ * (float). The shape did not matter (32 x 8, 8 x 32 and 256 x 1 alike; 16 x 4 and 64 x 1 as
+ * slow as 8 x 8). The shadow builds keep 8 x 8: with 256 work-items CSSM's blocks left too few
+ * work-groups for two cores. Issue #12, README "Interactive sessions". */
 static void choose_render_local(umbra_renderer r)
 {
     size_t kernel_wg = 0, device_wg = 0, items[3] = {0, 0, 0};
