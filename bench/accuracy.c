@@ -210,6 +210,9 @@ static void build_configs(int quick, int papers, uint32_t max_map, float exact_s
         if (maps[i] <= max_map)
             add_threshold(L, maps[i], 1, 0.5f);
     if (!quick) {
+        /* 13 taps is the library's default (umbra_shadow_desc_init): auto with 13 taps is the
+         * threshold map an application gets unless it asks for another. */
+        add_threshold(L, UMBRA_MAP_SIZE_AUTO, 13, 0.5f);
         add_threshold(L, 1024, 13, 0.5f);
         add_threshold(L, 1024, 1, 0.25f);
         add_threshold(L, 1024, 1, 0.75f);
