@@ -509,7 +509,7 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
  * runtime), and as fast on the bonsai and the foot (8-bit) and the Marschner-Lobb volume
  * (float). The shape did not matter (32 x 8, 8 x 32 and 256 x 1 alike; 16 x 4 and 64 x 1 as
  * slow as 8 x 8). The shadow builds keep 8 x 8: with 256 work-items CSSM's blocks left too few
- * work-groups for two cores. Issue #12, README "Interactive sessions". */
+ * work-groups for two cores. Issue #12, docs/performance.md. */
 static void choose_render_local(umbra_renderer r)
 {
     size_t kernel_wg = 0, device_wg = 0, items[3] = {0, 0, 0};
