@@ -93,7 +93,8 @@ typedef struct note_list {
 
 /* The command line (accuracy.c parse_options). */
 typedef struct options {
-    int quick, runs, warmup, plots, cache, list;
+    int quick, runs, warmup, plots, list;
+    int cache; /* read cached references (0: --no-cache); they are written either way */
     const char *images;      /* none | headline | all */
     char out[2048], cache_dir[2100], scene_dir[2048], main_scene[SCENE_NAME_MAX];
     char scenes[1024];       /* comma-separated names, "" for all */

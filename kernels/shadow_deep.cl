@@ -266,7 +266,11 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
          * DEEP_LUT_INTERIOR (a sharp feature), the smallest tolerance that needs no more, by
          * bisection between DEEP_LUT_TOL and the error of the straight line from 1 to the end
          * value (which needs none): 8 halvings, within 1/256 of that error of the optimum for
-         * this greedy fit. */
+         * this greedy fit. Every feasible fit writes its nodes as it goes, so none is fitted
+         * again: the entry is the first fit's if it is feasible, else the last feasible halving's, else the line's.
+         * Fitting the chosen tolerance once more, as this did before, took the table 1.18x the
+         * CPU time (perf samples over the walnut's opacity sequence, the same table bit for bit,
+         * issue #12). */
         int interior = deep_lut_fit(v, DEEP_LUT_TOL, DEEP_LUT_INTERIOR, out);
         if (interior > DEEP_LUT_INTERIOR) {
             float lo = DEEP_LUT_TOL, hi = DEEP_LUT_TOL;
@@ -275,26 +279,20 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
                 hi = fmax(hi, deep_max_abs(v[j] - mix((light_t)(1.0f), end, x)));
             }
             hi = hi * 1.001f + 1e-6f; /* rounding must not make the straight line infeasible */
-            /* Each feasible fit's nodes are kept, so no fit is repeated: the entry is the last
-             * feasible one's (the line's, if no halving was). Fitting the chosen tolerance once
-             * more, as this did before, took the table 1.18x the CPU time (perf samples over the
-             * walnut's opacity sequence, same tables bit for bit, issue #12). */
             deep_node tried[DEEP_LUT_NODES];
-            int found = 0;
             for (int it = 0; it < 8; ++it) {
                 float mid = 0.5f * (lo + hi);
                 int k = deep_lut_fit(v, mid, DEEP_LUT_INTERIOR, tried);
                 if (k <= DEEP_LUT_INTERIOR) {
                     hi = mid;
                     interior = k;
-                    found = 1;
                     for (int q = 0; q < k; ++q)
                         out[q] = tried[q];
                 } else {
                     lo = mid;
                 }
             }
-            if (!found)
+            if (interior > DEEP_LUT_INTERIOR) /* no halving was feasible: the line's */
                 interior = deep_lut_fit(v, hi, DEEP_LUT_NODES, out);
         }
         interior = min(interior, DEEP_LUT_INTERIOR);
