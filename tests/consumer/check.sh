@@ -7,6 +7,9 @@
 #     static libraries with --static), then with umbra as an add_subdirectory of theirs.
 #  3. A program linked only against umbra::umbra loads no OpenImageIO, Teem, ffmpeg or GDAL.
 #  4. The shared libraries export the public umbra_* API and nothing else.
+#  5. umbra_io configured with UMBRA_IO_IMAGES=OFF loads no OpenImageIO, still loads volumes and
+#     refuses images with UMBRA_ERROR_UNSUPPORTED; umbra-bench builds against it (it is how
+#     bench/device/pack.sh carries the bench to a GPU machine).
 set -euo pipefail
 src=$(cd "$1" && pwd)
 build=$(cd "$2" && pwd)
@@ -84,4 +87,18 @@ for lib in libumbra.so libumbra_io.so; do
   [ -z "$bad$internal" ] || { echo "$bad$internal" >&2; fail "$lib exports more than the public API"; }
   echo "$lib exports $(nm -D --defined-only "$libdir/$lib" | grep -c ' umbra_') umbra_* symbols"
 done
+echo "== umbra_io without OpenImageIO (UMBRA_IO_IMAGES=OFF)"
+noimg=$work/noimg
+cmake -S "$src" -B "$noimg" -DCMAKE_BUILD_TYPE=Release -DUMBRA_IO_IMAGES=OFF \
+      -DUMBRA_BUILD_TOOLS=OFF -DUMBRA_BUILD_TESTS=OFF -DUMBRA_BUILD_EXAMPLES=OFF \
+      -DUMBRA_INSTALL=OFF >/dev/null
+cmake --build "$noimg" -j"$jobs" --target umbra_io umbra-bench >/dev/null
+if ldd "$noimg/libumbra_io.so" "$noimg/umbra-bench" | grep -qi OpenImageIO; then
+  fail "the UMBRA_IO_IMAGES=OFF build loads OpenImageIO"
+fi
+cc -std=c11 -Wall -Wextra -Werror -DCL_TARGET_OPENCL_VERSION=120 -I"$src/include" \
+   -I"$noimg/generated/include" \
+   -o "$work/no_images" "$src/tests/consumer/no_images.c" -L"$noimg" -lumbra_io -lumbra \
+   -lOpenCL -Wl,-rpath,"$noimg"
+"$work/no_images" "$work"
 echo "check.sh: all consumers built and ran"
