@@ -129,6 +129,16 @@ umbra_context bench_context(const char *device)
     } else {
         d.device_name = device;
     }
+    /* The sampler, to compare the two back ends on one device (the library picks per device). */
+    const char *sampler = getenv("UMBRA_SAMPLER");
+    if (sampler && strcmp(sampler, "buffer") == 0) {
+        d.sampler = UMBRA_SAMPLER_BUFFER;
+    } else if (sampler && strcmp(sampler, "image") == 0) {
+        d.sampler = UMBRA_SAMPLER_IMAGE;
+    } else if (sampler && *sampler) {
+        fprintf(stderr, "umbra-bench: UMBRA_SAMPLER=%s: expected buffer or image\n", sampler);
+        return NULL;
+    }
     d.error_callback = print_error; /* creation failures have no context to keep the message */
     umbra_context ctx = NULL;
     if (umbra_context_create(&d, &ctx) != UMBRA_SUCCESS)
