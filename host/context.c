@@ -171,14 +171,11 @@ static umbra_status pick_device(const umbra_context_desc *desc, cl_platform_id *
 static void describe_device(umbra_context ctx, const umbra_context_desc *desc)
 {
     char pname[256] = "", dname[256] = "";
-    cl_device_type type = 0;
     cl_bool images = CL_FALSE;
     clGetPlatformInfo(ctx->platform, CL_PLATFORM_NAME, sizeof pname, pname, NULL);
     clGetDeviceInfo(ctx->device, CL_DEVICE_NAME, sizeof dname, dname, NULL);
-    clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL);
     clGetDeviceInfo(ctx->device, CL_DEVICE_IMAGE_SUPPORT, sizeof images, &images, NULL);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", pname, dname);
-    ctx->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
 
     ctx->has_float_r_image3d = ctx->has_unorm8_r_image3d = ctx->has_unorm16_r_image3d = 0;
     if (images) {
@@ -196,9 +193,10 @@ static void describe_device(umbra_context ctx, const umbra_context_desc *desc)
             }
         }
     }
+    /* AUTO is the buffer on every device (context.h says why: exact trilinear weights). */
     umbra_sampler_kind want = desc ? desc->sampler : UMBRA_SAMPLER_AUTO;
     if (want == UMBRA_SAMPLER_AUTO)
-        want = (!ctx->is_cpu && ctx->has_float_r_image3d) ? UMBRA_SAMPLER_IMAGE : UMBRA_SAMPLER_BUFFER;
+        want = UMBRA_SAMPLER_BUFFER;
     if (want == UMBRA_SAMPLER_IMAGE && !ctx->has_float_r_image3d)
         want = UMBRA_SAMPLER_BUFFER;
     ctx->sampler = want;

@@ -79,7 +79,6 @@ struct umbra_context_t {
     cl_command_queue app_queue;         /* the application's out-of-order queue, retained, when
                                            umbra runs on its own in-order queue; else NULL */
     int profiling;                      /* queue has CL_QUEUE_PROFILING_ENABLE: device times */
-    int is_cpu;
     int has_float_r_image3d;
     int has_unorm8_r_image3d, has_unorm16_r_image3d; /* CL_R 3D images of CL_UNORM_INT8 / 16 */
     umbra_sampler_kind sampler;
