@@ -129,7 +129,7 @@ umbra_context bench_context(const char *device)
     } else {
         d.device_name = device;
     }
-    /* The sampler, to compare the two back ends on one device (the library picks per device). */
+    /* The sampler, to compare the two back ends on one device (AUTO, the library's, otherwise). */
     const char *sampler = getenv("UMBRA_SAMPLER");
     if (sampler && strcmp(sampler, "buffer") == 0) {
         d.sampler = UMBRA_SAMPLER_BUFFER;

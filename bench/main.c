@@ -32,7 +32,7 @@ static void usage(FILE *f)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
         fprintf(f, "  %-12s %s\n", commands[i].name, commands[i].help);
     fprintf(f, "\nEnvironment: UMBRA_DEVICE picks the OpenCL device, UMBRA_SAMPLER its volume "
-               "sampler\n(buffer or image; default: the library's choice per device), "
+               "sampler\n(buffer or image; default: the library's, the buffer), "
                "UMBRA_DATA_DIR where the\nvolumes are, OMP_NUM_THREADS the native-C threads.\n");
 }
 
