@@ -159,41 +159,32 @@ static int range_visible(umbra_transfer_function tf, const uint32_t *visible,
     return hi >= lo && visible[hi + 1] > visible[lo];
 }
 
-/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf. */
-static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf (visible:
+ * visible_prefix's). */
+static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf,
+                                const uint32_t *visible, cl_mem *buf)
 {
     umbra_volume v = r->volume;
     const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     unsigned char *flags = malloc(n);
-    uint32_t *visible = visible_prefix(tf);
-    if (!visible) {
-        free(flags);
-        flags = NULL;
-    }
     for (size_t b = 0; flags && b < n; ++b)
         flags[b] = (unsigned char)range_visible(tf, visible, v->brick_minmax + 2 * b);
-    free(visible);
     return upload_table(r, flags, n, "brick table", buf);
 }
 
 /* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
- * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS). */
-static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf, cl_mem *buf)
+ * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS; visible as above). */
+static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf,
+                               const uint32_t *visible, cl_mem *buf)
 {
     umbra_volume v = r->volume;
     const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     const uint32_t cells = UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS * UMBRA_BRICK_CELLS;
     uint64_t *masks = calloc(n, sizeof *masks);
-    uint32_t *visible = visible_prefix(tf);
-    if (!visible) {
-        free(masks);
-        masks = NULL;
-    }
     for (size_t b = 0; masks && b < n; ++b)
         for (uint32_t c = 0; c < cells; ++c)
             if (range_visible(tf, visible, v->cell_minmax + 2 * (b * cells + c)))
                 masks[b] |= (uint64_t)1 << c;
-    free(visible);
     return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
 }
 
@@ -208,10 +199,15 @@ umbra_status umbra__tables(umbra_renderer r, umbra_transfer_function tf, float s
     if (*tf_buf && *cell_buf && (!brick_buf || *brick_buf) && memcmp(want, key, sizeof want) == 0)
         return UMBRA_SUCCESS;
     umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
+    uint32_t *visible = st == UMBRA_SUCCESS ? visible_prefix(tf) : NULL;
+    if (st == UMBRA_SUCCESS && !visible)
+        st = umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                         "umbra_renderer_render: out of memory for the visibility tables");
     if (st == UMBRA_SUCCESS && brick_buf)
-        st = brick_table(r, tf, brick_buf);
+        st = brick_table(r, tf, visible, brick_buf);
     if (st == UMBRA_SUCCESS)
-        st = cell_table(r, tf, cell_buf);
+        st = cell_table(r, tf, visible, cell_buf);
+    free(visible);
     if (st == UMBRA_SUCCESS)
         memcpy(key, want, sizeof want);
     else

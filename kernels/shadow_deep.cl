@@ -267,10 +267,10 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
          * bisection between DEEP_LUT_TOL and the error of the straight line from 1 to the end
          * value (which needs none): 8 halvings, within 1/256 of that error of the optimum for
          * this greedy fit. Every feasible fit writes its nodes as it goes, so none is fitted
-         * again: the entry is the first fit's if it is feasible, else the last feasible halving's, else the line's.
-         * Fitting the chosen tolerance once more, as this did before, took the table 1.18x the
-         * CPU time (perf samples over the walnut's opacity sequence, the same table bit for bit,
-         * issue #12). */
+         * again: the entry is the first fit's if it is feasible, else the last feasible
+         * halving's, else the line's. Fitting the chosen tolerance once more, as this did
+         * before, took the table 1.18x the CPU time (perf samples over the walnut's opacity
+         * sequence, the same table bit for bit, issue #12). */
         int interior = deep_lut_fit(v, DEEP_LUT_TOL, DEEP_LUT_INTERIOR, out);
         if (interior > DEEP_LUT_INTERIOR) {
             float lo = DEEP_LUT_TOL, hi = DEEP_LUT_TOL;
