@@ -454,7 +454,7 @@ static umbra_status program_get_locked(umbra_context ctx, const char *const *fil
         st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra__program_get: %zu files", nfiles);
         goto fail;
     }
-    sources[0] = umbra__kernel_source("umbra_shared.h");
+    sources[0] = umbra__kernel_source("common/umbra_shared.h");
     for (size_t i = 0; i < nfiles; ++i) {
         sources[i + 1] = umbra__kernel_source(files[i]);
         if (!sources[i + 1] || !sources[0]) {

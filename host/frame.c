@@ -181,7 +181,8 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
                      r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
                      voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
                      r->volume ? r->volume->clamps : 1);
-    /* A volume in several slabs: kernels/sampling.cl takes one parameter per slab. One slab adds
+    /* A volume in several slabs: kernels/common/sampling.cl takes one parameter per slab. One slab
+     * adds
      * nothing, so its programs stay those of the single-buffer code. */
     if (r->volume && r->volume->slab_count > 1 && n > 0 && (size_t)n < size)
         snprintf(buf + n, size - (size_t)n, " -DUMBRA_VOLUME_SLABS=%u -DUMBRA_SLAB_STEP=%u",
@@ -196,7 +197,7 @@ umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)
     /* A shadow build runs before the view tables exist and does not read them: any buffer will
      * do for the argument. */
     cl_mem view_bricks = r->view_bricks_buf ? r->view_bricks_buf : r->light_cells_buf;
-    /* VOLUME_PARAM (kernels/sampling.cl) is one parameter per slab. */
+    /* VOLUME_PARAM (kernels/common/sampling.cl) is one parameter per slab. */
     const cl_uint nslabs = r->volume->slab_count;
     cl_mem args[2 + UMBRA__MAX_SLABS + 5] = {r->frame_buf};
     memcpy(args + 1, r->volume->slabs, nslabs * sizeof(cl_mem));

@@ -121,7 +121,8 @@ double umbra__now_ms(void);
 
 /* ---- volume ---------------------------------------------------------------------------------- */
 
-/* The most z-slabs a volume may be split into: each is a kernel parameter (kernels/sampling.cl
+/* The most z-slabs a volume may be split into: each is a kernel parameter
+ * (kernels/common/sampling.cl
  * spells out this many). */
 #define UMBRA__MAX_SLABS 8
 
@@ -136,7 +137,7 @@ struct umbra_volume_t {
     uint32_t brick_counts[3];
     float *brick_minmax;     /* host: 2 floats (normalised min, max) per brick */
     float *cell_minmax;      /* host: the same per sub-cell, UMBRA_BRICK_CELLS^3 per brick,
-                                brick-major, x fastest (kernels/umbra_shared.h) */
+                                brick-major, x fastest (kernels/common/umbra_shared.h) */
     /* The voxels on the device, in slab_count z-slabs (slab s holds the layers
      * [s * slab_step, (s + 1) * slab_step] clipped to the grid, host/volume_slabs.c): buffers of
      * the input type's raw values, or normalised float32 (stored_type FLOAT32 with value_map
@@ -203,7 +204,7 @@ void umbra__slab_layers(umbra_volume v, uint32_t s, uint32_t *z0, uint32_t *z1);
 umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes);
 
 /* v's voxels read back and normalised to [0,1] as the kernels normalise them (voxel_normalise in
- * kernels/sampling.cl): dims[0] * dims[1] * dims[2] floats into out, x fastest. Blocks. */
+ * kernels/common/sampling.cl): dims[0] * dims[1] * dims[2] floats into out, x fastest. Blocks. */
 umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/lightspace.h: the light-space map projection shared by the shadow-map techniques
- * (threshold, deep, CSSM). See kernels/lightspace.cl for the kernel side. */
+ * (threshold, deep, CSSM). See kernels/common/lightspace.cl for the kernel side. */
 #ifndef UMBRA_LIGHTSPACE_H
 #define UMBRA_LIGHTSPACE_H
 

@@ -55,7 +55,7 @@ umbra_status umbra__preint_ensure(umbra_context ctx, const char *func, umbra__pr
         *buf = t->buffer;
         return UMBRA_SUCCESS;
     }
-    const char *files[] = {"common.cl", "preintegration.cl"};
+    const char *files[] = {"common/common.cl", "common/preintegration.cl"};
     cl_program program;
     if ((st = umbra__program_get(ctx, files, 2, "", &program)) != UMBRA_SUCCESS)
         return st;

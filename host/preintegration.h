@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/preintegration.h: pre-integration tables on the device (kernels/preintegration.cl), shared
- * by the convolution shadows (host/shadow_convolution.c) and the ray caster's pre-integrated mode
+/* host/preintegration.h: pre-integration tables on the device (kernels/common/preintegration.cl),
+ * shared
+ * by the convolution shadows (host/techniques/convolution.c) and the ray caster's pre-integrated
+ * mode
  * (host/renderer.c). A table is a cache: it is recomputed only when the transfer function, the
  * segment length, the kind or the transmission mode it was made for change. */
 #ifndef UMBRA_PREINTEGRATION_H

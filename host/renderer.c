@@ -15,10 +15,10 @@
 #include "preintegration.h"
 #include "renderer_internal.h"
 
-extern const umbra__technique umbra__technique_threshold; /* host/shadow_maps.c */
-extern const umbra__technique umbra__technique_cssm;      /* host/shadow_maps.c */
-extern const umbra__technique umbra__technique_deep;      /* host/shadow_deep.c */
-extern const umbra__technique umbra__technique_convolution; /* host/shadow_convolution.c */
+extern const umbra__technique umbra__technique_threshold; /* host/techniques/maps.c */
+extern const umbra__technique umbra__technique_cssm;      /* host/techniques/maps.c */
+extern const umbra__technique umbra__technique_deep;      /* host/techniques/deep.c */
+extern const umbra__technique umbra__technique_convolution; /* host/techniques/convolution.c */
 
 static const umbra__technique *const techniques[] = {
     &umbra__technique_none,
@@ -528,8 +528,9 @@ static void choose_render_local(umbra_renderer r)
 static umbra_status ensure_kernels(umbra_renderer r)
 {
     char options[256];
-    /* lightspace.cl: the map projection the light-space techniques' lookups need. */
-    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "preintegration.cl",
+    /* common/lightspace.cl: the map projection the light-space techniques' lookups need. */
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/lightspace.cl",
+                           "common/preintegration.cl",
                            r->tech->kernel_file, "raycast.cl"};
     cl_program program;
     umbra__build_options(r, options, sizeof options);

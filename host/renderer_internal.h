@@ -3,7 +3,7 @@
  *
  * A shadow technique is a table of functions (umbra__technique) plus, for per-sample techniques,
  * a kernels/shadow_<name>.cl file compiled into the ray caster's program (the kernel side of the
- * interface is described in kernels/shadow_none.cl). To add a technique: write both, add its
+ * interface is described in kernels/techniques/none.cl). To add a technique: write both, add its
  * table to the list in host/renderer.c, and its name to umbra_shadow_technique. */
 #ifndef UMBRA_RENDERER_INTERNAL_H
 #define UMBRA_RENDERER_INTERNAL_H
@@ -11,7 +11,7 @@
 #include <math.h>
 
 #include "internal.h"
-#include "umbra_shared.h"
+#include "common/umbra_shared.h"
 
 _Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
 _Static_assert(sizeof(UmbraShadow) == 6 * 16 + 3 * 4 + 8 * 4 + 13 * 4, "UmbraShadow layout");
@@ -160,7 +160,7 @@ float umbra__voxel_world(umbra_renderer r);
 void umbra__frame_update_light(umbra_renderer r);
 
 /* Makes sure r->light_tf_buf holds the light table (alphas as given: the kernels correct per
- * sample, kernels/common.cl) and r->light_cells_buf the visibility of each brick's sub-cells
+ * sample, kernels/common/common.cl) and r->light_cells_buf the visibility of each brick's sub-cells
  * under it. */
 umbra_status umbra__light_tables(umbra_renderer r);
 

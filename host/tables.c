@@ -18,9 +18,10 @@ float umbra__voxel_world(umbra_renderer r)
 }
 
 /* The integral over table interval i (from entry i to i + 1, in table units) of the extinction
- * -ln(1 - a) (a at most 1 - 2^-24, kernels/common.cl) times 1 - t_c for c = r, g, b and times 1
+ * -ln(1 - a) (a at most 1 - 2^-24, kernels/common/common.cl) times 1 - t_c for c = r, g, b and
+ * times 1
  * (grey), the entries interpolated linearly: in closed form, in double, as piece_depth in
- * kernels/shadow_reference.cl integrates parts of an interval (the same formula, so that whole
+ * kernels/techniques/reference.cl integrates parts of an interval (the same formula, so that whole
  * and partial intervals agree): from the more transparent end e, with r = (a_o - a_e) /
  * (1 - a_e), the mean extinction is s_e + phi(r) and the mean of tau times it s_e / 2 + psi(r),
  * phi(r) = 1 + (1 - r) ln(1 - r) / r, psi(r) = (-ln(1 - r) (1 - 1 / r^2) + 1 / r + 1 / 2) / 2,
@@ -85,12 +86,13 @@ fail:
 
 /* A copy of tf with alpha corrected for a step of step_voxels: 1 - (1 - a)^step, computed as
  * -expm1(step log1p(-a)) in double so that near-transparent entries keep their precision (as
- * alpha_for_length in kernels/common.cl). step_voxels 0 makes the light table: the alphas as
- * given (kernels convert the interpolated alpha to extinction per sample, kernels/common.cl),
+ * alpha_for_length in kernels/common/common.cl). step_voxels 0 makes the light table: the alphas as
+ * given (kernels convert the interpolated alpha to extinction per sample,
+ * kernels/common/common.cl),
  * followed by 2 count float4: for each entry k, the sum over the intervals before it of
  * interval_depths (r, g, b, grey), as a float pair hi, lo (hi + lo, the double sum to ~1e-14),
  * from which the exact reference takes the depth of whole table intervals with two loads and no
- * cancellation (kernels/shadow_reference.cl), then count float4 holding each entry's extinction
+ * cancellation (kernels/techniques/reference.cl), then count float4 holding each entry's extinction
  * -ln(1 - a) (a clamped to 1 - 2^-24) in x, so that it takes no log at a table entry. */
 static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
                                     cl_mem *buf)
@@ -173,7 +175,7 @@ static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf,
 }
 
 /* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
- * alpha > 0 under tf (kernels/umbra_shared.h, UMBRA_BRICK_CELLS; visible as above). */
+ * alpha > 0 under tf (kernels/common/umbra_shared.h, UMBRA_BRICK_CELLS; visible as above). */
 static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf,
                                const uint32_t *visible, cl_mem *buf)
 {

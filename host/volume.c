@@ -3,7 +3,8 @@
  *
  * Voxels stay in their own type on the device (1, 2 or 4 bytes each), in a buffer (buffer
  * sampler) or a CL_R 3D image (image sampler), and the kernels map them to [0,1] through the
- * value range as they read them (kernels/sampling.cl); the few cases that cannot be stored as
+ * value range as they read them (kernels/common/sampling.cl); the few cases that cannot be stored
+ * as
  * given (see volume_create) are normalised to float32 on the way, a few MiB at a time. Each brick
  * and each of its sub-cells keeps the min and max normalised value over the voxels its trilinear
  * footprint reads (its own and the next layer), so a brick or cell whose whole range maps to zero
@@ -17,7 +18,7 @@
 #include <unistd.h>
 
 #include "internal.h"
-#include "umbra_shared.h"
+#include "common/umbra_shared.h"
 
 size_t umbra_scalar_type_size(umbra_scalar_type type)
 {

@@ -5,7 +5,8 @@
  *
  * Slab s holds the voxel layers [s * step, (s + 1) * step] clipped to the grid: neighbours share
  * one layer (the apron), so every trilinear sample, and every central-difference gradient built
- * from such samples, reads one slab only (kernels/sampling.cl picks it by the sample's z). The
+ * from such samples, reads one slab only (kernels/common/sampling.cl picks it by the sample's z).
+ * The
  * plan is made, and checked against the device's global memory, before anything is allocated, so
  * a volume that cannot fit is refused with its sizes instead of failing half-way through.
  *
@@ -209,7 +210,8 @@ umbra_status umbra__volume_read_normalised(umbra_volume v, float *out)
         }
         default: memcpy(&s, raw + 4 * i, 4); break;
         }
-        /* As voxel_normalise in kernels/sampling.cl, with an image's UNORM texels read as the
+        /* As voxel_normalise in kernels/common/sampling.cl, with an image's UNORM texels read as
+         * the
          * integers they encode (value_map[0] is in those units). */
         float x = (s - v->value_map[0]) * v->value_map[1];
         out[i] = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);

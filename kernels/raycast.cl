@@ -5,7 +5,8 @@
  * empty-space skipping over bricks the view transfer function leaves empty, a seeded jittered
  * start, optional Blinn-Phong shading, and an optional opaque ground plane. Every sample with
  * non-zero opacity, and every ground-plane hit, takes its RGB shadow factor from the shadow
- * technique compiled into this program (see kernels/shadow_none.cl for the interface). The host's
+ * technique compiled into this program (see kernels/techniques/none.cl for the interface). The
+ * host's
  * plain-C twin, tests/reference/cpu_reference.c, follows this file step for step (it takes each
  * sample's light at once, where the kernel takes it one sample late: the same arithmetic in the
  * same order per pixel, see the sample loop). */
@@ -146,7 +147,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         /* At most UMBRA_MAX_RAY_SAMPLES + 1: the host refuses steps that would take more along
          * the box's diagonal (host/renderer.c, check_ray_samples), so this fits an int. */
         const int n = (int)ceil((t1 - t0) / h - jitter);
-        /* Pre-integrated mode (preint_size != 0, kernels/preintegration.cl): sample k stands for
+        /* Pre-integrated mode (preint_size != 0, kernels/common/preintegration.cl): sample k stands
+         * for
          * the segment [t, t + h], its colour and opacity from the table at (s(t), s(t + h)), its
          * shading taken at the front (its shadow: shadow_point). The back value is kept for the
          * next segment. */

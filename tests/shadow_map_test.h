@@ -64,7 +64,8 @@ static inline void mt_texel_point(umbra_renderer r, uint32_t i, uint32_t j, floa
         p[k] = a * S->ls_u[k] + b * S->ls_v[k] + along * S->ls_w[k];
 }
 
-/* The tap offsets of kernels/lightspace.cl (ls_taps), the first `taps` of them for each set. */
+/* The tap offsets of kernels/common/lightspace.cl (ls_taps), the first `taps` of them for each set.
+ * */
 static const int mt_taps[21][2] = {{0, 0},   {4, 0},   {-4, 0}, {0, 4},  {0, -4},  {3, 3},  {-3, -3},
                                    {3, -3},  {-3, 3},  {7, 0},  {-7, 0}, {0, 7},   {0, -7}, {5, 5},
                                    {-5, -5}, {5, -5},  {-5, 5}, {10, 0}, {-10, 0}, {0, 10}, {0, -10}};

@@ -27,7 +27,7 @@
 #include <string.h>
 
 #include "preintegration.h"
-#include "shadow_convolution.h"
+#include "techniques/convolution.h"
 #include "test_util.h"
 
 /* ---- helpers --------------------------------------------------------------------------------- */

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* tests/test_cssm.c: colored stochastic shadow maps (kernels/shadow_cssm.cl) pinned down.
+/* tests/test_cssm.c: colored stochastic shadow maps (kernels/techniques/cssm.cl) pinned down.
  *
  * Statistics. A texel's photon is stopped in segment i with probability rho_i given that it got
  * there, so a sample at depth s is lit by that texel with probability P = prod (1 - rho_i) over

@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "shadow_deep.h"
+#include "techniques/deep.h"
 #include "test_util.h"
 
 /* ---- helpers --------------------------------------------------------------------------------- */
@@ -113,7 +113,7 @@ static int ray_box_d(const double o[3], const double d[3], double lo, double hi,
 }
 
 /* The ray through map position (x, y) in texels of the current orthographic map: the host twin
- * of ls_texel_ray in kernels/lightspace.cl, in double precision. */
+ * of ls_texel_ray in kernels/common/lightspace.cl, in double precision. */
 static void ortho_ray(umbra_renderer r, double x, double y, double o[3], double d[3])
 {
     const UmbraShadow *S = &r->shadow_params;
@@ -127,7 +127,7 @@ static void ortho_ray(umbra_renderer r, double x, double y, double o[3], double 
     }
 }
 
-/* The 5-tap pre-filter of kernels/shadow_deep.cl: (dx, dy, weight). */
+/* The 5-tap pre-filter of kernels/techniques/deep.cl: (dx, dy, weight). */
 static const double prefilter_taps[5][3] = {
     {0.0, 0.0, 0.5},    {-0.5, -0.5, 0.125}, {0.5, -0.5, 0.125},
     {-0.5, 0.5, 0.125}, {0.5, 0.5, 0.125}};

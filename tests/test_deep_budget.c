@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "shadow_deep.h"
+#include "techniques/deep.h"
 #include "test_util.h"
 
 enum { N_VOX = 48, W = 96, H = 96 };

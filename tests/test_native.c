@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_native.c: volumes stored on the device in their own type (host/volume.c,
- * kernels/sampling.cl).
+ * kernels/common/sampling.cl).
  *
  *  - uint8, uint16 and int16 volumes (int16 over its whole range, -32768 included) render the
  *    same image as a float volume holding the same values already normalised in double (what
@@ -19,7 +19,7 @@
  *    copy), returns the fill's failure as is and refuses desc->data. */
 #include "internal.h" /* the volume's tables and storage */
 #include "test_util.h"
-#include "umbra_shared.h"
+#include "common/umbra_shared.h"
 
 #include <float.h>
 #include <math.h>

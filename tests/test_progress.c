@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "renderer_internal.h"
-#include "shadow_deep.h"
+#include "techniques/deep.h"
 #include "test_util.h"
 
 enum { W = 48, H = 40, MAXCALLS = 100000 };

@@ -241,7 +241,8 @@ static void test_reference_slab_matches_exp(void **state)
 /* Hard cases of promise 2: near-opaque and near-transparent material over paths up to 512
  * voxels, with an axis-aligned and an oblique light. Expected: exp(d log(1 - a)) in double.
  * Bounds: near-opaque, 1e-3 relative, or 1.5e-6 absolute where the shadow ray stops (it returns
- * 0 once the transmittance drops below 1e-6, kernels/shadow_reference.cl); near-transparent, 1% of
+ * 0 once the transmittance drops below 1e-6, kernels/techniques/reference.cl); near-transparent, 1%
+ * of
  * the attenuation 1 - T plus 2e-7. (Written when the transmittance was a float product, whose
  * factors 1 - a/4 each lost half an ulp; since issue 10 the reference sums optical depths, and
  * tests/test_fidelity.c holds a = 1e-6 over 512 voxels to 3e-7 at steps down to 0.01.) */
@@ -418,7 +419,7 @@ static void test_raycast_matches_cpu_reference(void **state)
                       err, (unsigned long long)stats.samples, (unsigned long long)samples);
         /* 1e-4 per channel. With the exact reference, 1e-3 at a few values: its shadow rays
          * refine a segment where the extinction along it varies by more than a threshold
-         * (kernels/shadow_reference.cl), and float rounding that differs between the two can
+         * (kernels/techniques/reference.cl), and float rounding that differs between the two can
          * put a segment on either side of it, which moves that ray's value by up to the
          * refinement's own tolerance; at most 0.5% of the values may differ by more than 1e-4. */
         size_t over = 0;
@@ -482,7 +483,8 @@ static umbra_volume make_noisy_uint8_volume(umbra_context ctx, uint32_t nx, uint
 }
 
 /* Gradient shading as umbra takes it since issue #12 (the gradient from the 32 voxels of one
- * stencil, the specular power by binary powering: kernels/sampling.cl, kernels/common.cl)
+ * stencil, the specular power by binary powering: kernels/common/sampling.cl,
+ * kernels/common/common.cl)
  * against the form before it (six trilinear samples, pow), as the C twin still computes it on
  * request: the image may change only by float rounding, at most SHADING_BOUND per channel. The
  * two gradients are the same sum, rounded differently (cancellation of two interpolated values

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_slabs.c: volumes split into z-slabs beyond one device allocation (host/
- * volume_slabs.c, kernels/sampling.cl), pinned down:
+ * volume_slabs.c, kernels/common/sampling.cl), pinned down:
  *  - the slab plan, for every depth and allocation size up to a bound: the fewest slabs, each
  *    within the allocation, and every trilinear footprint (layers z, z + 1) inside the slab the
  *    kernels pick for z;
@@ -164,7 +164,7 @@ static void test_slab_plan_covers_every_footprint(void **state)
                 sum += z1 - z0 + 1;
             }
             assert_int_equal(sum + count, bytes);
-            /* The kernels' pick (kernels/sampling.cl) for each footprint's first layer. */
+            /* The kernels' pick (kernels/common/sampling.cl) for each footprint's first layer. */
             for (uint32_t z = 0; z < nz; ++z) {
                 uint32_t s = count == 1 ? 0 : z / step;
                 s = s > count - 1 ? count - 1 : s;
@@ -354,7 +354,7 @@ static void compare_techniques(umbra_context ctx, umbra_scalar_type type, unsign
                                uint64_t fit_layers, uint32_t slabs, double tol)
 {
     float *voxels = scene_voxels();
-    /* fit_layers layers and a buffer's pad element (kernels/sampling.cl reads x pairs). */
+    /* fit_layers layers and a buffer's pad element (kernels/common/sampling.cl reads x pairs). */
     const size_t esize = umbra_scalar_type_size(type);
     const uint64_t limit = fit_layers * (LAYER / sizeof(float) * esize) + esize;
     umbra_volume vols[2] = {scene_volume_typed(ctx, voxels, type, 0, 1),

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* tests/test_threshold.c: the opacity-threshold shadow map (kernels/shadow_threshold.cl) pinned
+/* tests/test_threshold.c: the opacity-threshold shadow map (kernels/techniques/threshold.cl) pinned
  * down:
  *  - homogeneous slab: along a light ray the factor flips from 1 to 0 at the analytic crossing
  *    d* = -ln(1 - threshold) / sigma (sigma = -ln(1 - alpha) per voxel) within one light step,

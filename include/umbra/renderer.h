@@ -179,7 +179,8 @@ typedef struct umbra_shadow_desc {
                                     light through (README, "Opacity-threshold shadow map") */
     uint32_t taps;               /* CSSM / filtered threshold: texels averaged per lookup, 1, 7,
                                     13 (the paper's set) or 21 (default 13); the offsets are
-                                    listed in kernels/lightspace.cl. They are fixed in texels:
+                                    listed in kernels/common/lightspace.cl. They are fixed in
+                                    texels:
                                     more taps reach farther (radius 4, 7, 10), trading noise for
                                     a wider blur of shadow edges */
     float epsilon;               /* deep map: compression error bound in [0, 1] (default 0.02) */

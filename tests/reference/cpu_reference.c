@@ -2,7 +2,7 @@
 /* tests/reference/cpu_reference.c: see cpu_reference.h. Plain C99 with OpenMP; every formula is
  * restated here from the documented model rather than shared with the library, so a mistake in
  * one is not silently repeated in the other. Why one file past 800 lines: it is one renderer,
- * read side by side with kernels/raycast.cl and shadow_reference.cl, step for step. */
+ * read side by side with kernels/raycast.cl and techniques/reference.cl, step for step. */
 #include "cpu_reference.h"
 
 #include <float.h>
@@ -129,7 +129,7 @@ static unsigned char *bricks(const prep *P, const float *tf, int n)
     return out;
 }
 
-/* The kernels' UMBRA_BRICK_CELLS (kernels/umbra_shared.h): each brick split into CELLS^3
+/* The kernels' UMBRA_BRICK_CELLS (kernels/common/umbra_shared.h): each brick split into CELLS^3
  * sub-cells of ceil(B / CELLS) voxels. Bit (x + CELLS (y + CELLS z)) of a brick's mask is set if
  * a voxel of the sub-cell's trilinear footprint (clamped to the grid; a cell beyond the last
  * voxel takes the last voxel) maps to alpha > 0. */
@@ -167,7 +167,8 @@ static uint64_t *cells(const prep *P, const float *tf, int n)
     return out;
 }
 
-/* The view ray's walk over the bricks' sub-cells (the kernels' CellWalk, kernels/common.cl): a
+/* The view ray's walk over the bricks' sub-cells (the kernels' CellWalk, kernels/common/common.cl):
+ * a
  * 3D DDA in voxel coordinates; along each axis brick b's cell j covers [b B + j C,
  * b B + min((j + 1) C, B)), the border cells reaching on to infinity. */
 typedef struct walk {
@@ -474,7 +475,7 @@ static void piece(const prep *P, float a, float b, double out[3], float *lo, flo
 
 /* Optical depth of a segment of len voxels whose value runs linearly from v0 to v1: len times
  * the mean extinction over [v0, v1]: the partial table intervals at the ends and the whole ones
- * between in closed form (piece, light_int), as kernels/shadow_reference.cl; *spread: the range
+ * between in closed form (piece, light_int), as kernels/techniques/reference.cl; *spread: the range
  * of the extinction over the pieces' ends and the whole intervals' mean, times len. */
 static void segment(const prep *P, float v0, float v1, float len, float out[3], float *spread)
 {
@@ -540,7 +541,7 @@ static float kink(const prep *P, const float xo[3], const float xd[3], float ta,
     return best;
 }
 
-/* segment (len voxels, depth f, spread) refined as kernels/shadow_reference.cl does: a
+/* segment (len voxels, depth f, spread) refined as kernels/techniques/reference.cl does: a
  * candidate for a split at a new sample at a plane of voxel centres it crosses if the extinction
  * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
  * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
@@ -585,7 +586,7 @@ static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const 
  * step partial), each segment's optical depth integrated through the transfer function, depths
  * summed in double and exponentiated once. It skips segments whose two ends lie in bricks the
  * light transfer function leaves empty, where the kernel walks their sub-cells
- * (kernels/shadow_reference.cl): both skip only segments of depth 0 (but for a visible cell
+ * (kernels/techniques/reference.cl): both skip only segments of depth 0 (but for a visible cell
  * crossed between two samples, which neither samples), so the simpler test stays an independent
  * check of the kernel's walk. */
 static v3 shadow(const prep *P, v3 p)
@@ -617,7 +618,7 @@ static v3 shadow(const prep *P, v3 p)
             continue;
         /* h_vox voxels a whole step, h_vox last / h the final one; its pieces divide that at
          * h_vox / h voxels per unit of t (its t-length can round to 0, kernels/
-         * shadow_reference.cl) */
+         * techniques/reference.cl) */
         float va = sample(P, qa), vb = sample(P, qb), len = k < n_full ? h_vox : last * (h_vox / h);
         float f[3], spread;
         segment(P, va, vb, len, f, &spread);
@@ -646,7 +647,7 @@ static v3 gradient_six_samples(const prep *P, v3 p)
     return vmul(mul(mk(gx, gy, gz), 0.5f), P->inv_spacing);
 }
 
-/* x^n as the kernel takes the specular power (kernels/common.cl, shading_power): by binary
+/* x^n as the kernel takes the specular power (kernels/common/common.cl, shading_power): by binary
  * powering for a whole n up to 256, within (n - 1) 2^-24 relative of powf, else powf. */
 static float shading_power(float x, float n)
 {
@@ -665,7 +666,7 @@ static float shading_power(float x, float n)
 }
 
 /* The central difference of the trilinear interpolant, (sample(p + e) - sample(p - e)) / 2 per
- * axis, one voxel e each way, computed as the kernel does (kernels/sampling.cl,
+ * axis, one voxel e each way, computed as the kernel does (kernels/common/sampling.cl,
  * volume_gradient): the voxels' central differences interpolated over p's cell, from the 32
  * voxels the six samples read, indices clamped one by one. */
 static v3 gradient(const prep *P, v3 p)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_cssm.cl: colored stochastic shadow maps for direct volume rendering (Weidner &
+/* kernels/techniques/cssm.cl: colored stochastic shadow maps for direct volume rendering (Weidner &
  * Linsen, after McGuire & Enderton's CSSM for surfaces).
  *
  * Generation, the paper's Table 1 (cssm_build): one photon per texel on a light ray discretised
@@ -7,7 +7,8 @@
  * segment i, and the depth of the first segment that stops it stored per channel. The paper has
  * rho_i = alpha_i (1 - t_i) (t the light transfer function's RGB in coloured mode, 0 in grey
  * mode); umbra takes rho_i = 1 - exp(-od_i), od_i = -ln(1 - alpha_i) (1 - t_i) the segment's
- * optical depth in the shading model's extinction (kernels/common.cl, light_depth), of which the
+ * optical depth in the shading model's extinction (kernels/common/common.cl, light_depth), of which
+ * the
  * paper's is the first-order form: the two agree in grey mode and for thin segments, and only
  * umbra's is independent of the step in a homogeneous medium. With UMBRA_LIGHT_CHANNELS == 1 (a
  * grey light) one channel is simulated and stored, not three. Two deviations, both keeping each
@@ -70,7 +71,8 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 #define LIGHT_FROM(a) ((float3)((a)[0], (a)[1], (a)[2]))
 #endif
 
-/* light_depth (kernels/common.cl) without its library call: the march needs a segment's optical
+/* light_depth (kernels/common/common.cl) without its library call: the march needs a segment's
+ * optical
  * depth at every segment of material, and PoCL's log1p, a call per segment, was a fifth of a
  * build (1.3x-1.6x the builds of a per-segment test that mostly avoided it). For alpha up to 0.5,
  * -ln(1 - a) = 2 atanh(s) with s = a / (2 - a) <= 1/3, summed to s^13: within 1.8 float epsilons

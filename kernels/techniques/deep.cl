@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_deep.cl: deep shadow maps for volume ray casting (Hadwiger, Kratz, Sigg and
+/* kernels/techniques/deep.cl: deep shadow maps for volume ray casting (Hadwiger, Kratz, Sigg and
  * Buehler 2006, after Lokovic and Veach 2000). One file past 800 lines, because an OpenCL program
  * is built from one source here and the three stages share the texel's march and compression.
- * Three build stages, compiled (DEEP_BUILD_KERNELS=1) into the build program of host/shadow_deep.c:
+ * Three build stages, compiled (DEEP_BUILD_KERNELS=1) into the build program of
+ * host/techniques/deep.c:
  *
  *   deep_lut          the pre-compressed segment table: for every pair of successive quantised
  *                     light-ray samples (s_f, s_b) the visibility of the segment between them,
@@ -16,7 +17,7 @@
  *                     pool with an atomic counter;
  *   deep_build_fixed  the same march with a fixed budget of max_nodes nodes per texel in a flat
  *                     array (for comparisons at equal memory, as in the CSSM paper), in
- *                     kernels/shadow_deep_budget.cl;
+ *                     kernels/techniques/deep_budget.cl;
  * and the lookup (SHADOW_FACTOR) the ray caster calls for every sample, which is all the ray
  * caster's program compiles of this file.
  *
@@ -30,7 +31,8 @@
  * the pre-filtered sub-rays can be combined segment by segment and no texel gets its own sampling
  * phase. A segment fully inside the box is integrated with the lookup table from the scalars at its
  * two ends, or (lookup_table = 0) with one sample at its midpoint, its optical depth that of the
- * shading model's extinction over the segment (kernels/common.cl), so a homogeneous medium gives
+ * shading model's extinction over the segment (kernels/common/common.cl), so a homogeneous medium
+ * gives
  * exp(-sigma d) at every node with or without the table. The partial segments where a ray enters
  * or leaves the box always use the midpoint rule over their length. */
 
@@ -47,10 +49,10 @@
 #define DEEP_SUB_RAYS 1
 #endif
 #if DEEP_SUB_RAYS != 1 && DEEP_SUB_RAYS != 5
-#error "DEEP_SUB_RAYS must be 1 or 5 (host/shadow_deep.c)"
+#error "DEEP_SUB_RAYS must be 1 or 5 (host/techniques/deep.c)"
 #endif
 
-/* Must match host/shadow_deep.h. */
+/* Must match host/techniques/deep.h. */
 #define DEEP_LUT_RES 256          /* quantised scalar values per table axis */
 #define DEEP_LUT_INTERIOR 3       /* interior nodes per table entry, at most */
 #define DEEP_LUT_NODES (DEEP_LUT_INTERIOR + 1) /* stored per entry: interior nodes + the end */
@@ -203,7 +205,7 @@ inline void deep_fit_finish(DeepFit *f, deep_node *e, int *n)
 /* ---- the pre-compressed segment table -------------------------------------------------------
  * Entry (i_f, i_b) covers a segment of one light step h whose scalar runs linearly from
  * s_f = i_f / (R-1) to s_b = i_b / (R-1). Its visibility is integrated at DEEP_LUT_SUBSTEPS
- * midpoint sub-steps of h / DEEP_LUT_SUBSTEPS each (the extinction of kernels/common.cl),
+ * midpoint sub-steps of h / DEEP_LUT_SUBSTEPS each (the extinction of kernels/common/common.cl),
  * then compressed with the fit above within DEEP_LUT_TOL, or, where that needs more than
  * DEEP_LUT_INTERIOR interior nodes, within the smallest tolerance that needs no more. The end
  * value is exact (the fit pins the last point). Stored: DEEP_LUT_NODES nodes (x in (0, 1],
@@ -524,7 +526,8 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
                 continue;
             }
             if (ka < 2 && kb < 2) {
-                /* Both ends in sub-cells it leaves empty (kernels/umbra_shared.h): transparent
+                /* Both ends in sub-cells it leaves empty (kernels/common/umbra_shared.h):
+                 * transparent
                  * too, as the threshold map's and CSSM's walks take them. Half the walnut's
                  * segments in non-empty bricks are, and each saved a sample, a table entry and a
                  * step of the fit. If every sub-ray is, the march jumps to the cells' exits. */
@@ -761,7 +764,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
         counts[gy * n + gx] = written;
 }
 
-/* deep_build_fixed, the build with a fixed node budget, is in kernels/shadow_deep_budget.cl
+/* deep_build_fixed, the build with a fixed node budget, is in kernels/techniques/deep_budget.cl
  * (appended after this file in the build program only). */
 
 #endif /* DEEP_BUILD_KERNELS */
@@ -811,7 +814,7 @@ inline float3 deep_shadow(__global const UmbraShadow *S, __global const deep_nod
     const int idx = t.y * n + t.x;
     const int fixed = S->max_nodes > 0u;
     const uint K = S->block_size;
-    /* The tile is a power of two (host/shadow_deep.c): shifts and masks, not four divisions. */
+    /* The tile is a power of two (host/techniques/deep.c): shifts and masks, not four divisions. */
     const int T = (int)S->deep_tile, shift = 31 - (int)clz((uint)T);
     const size_t T2 = (size_t)(T * T);
     const int tile = (t.y >> shift) * (int)S->tiles_per_row + (t.x >> shift);

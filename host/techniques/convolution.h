@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/shadow_convolution.h: internals of the convolution shadows that the tests look at. The
+/* host/techniques/convolution.h: internals of the convolution shadows that the tests look at. The
  * technique itself is umbra__technique_convolution (renderer_internal.h). */
 #ifndef UMBRA_SHADOW_CONVOLUTION_H
 #define UMBRA_SHADOW_CONVOLUTION_H

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/umbra_shared.h: structs shared by the host and the kernels.
+/* kernels/common/umbra_shared.h: structs shared by the host and the kernels.
  *
  * This file is compiled twice: as C by the host (the host modules include it) and as OpenCL C, prepended
  * to every program. Only fixed-width scalars and arrays of them appear here, so the layout is the
@@ -21,7 +21,7 @@ typedef int int32_t;
  * brick, for the view and for the light transfer function. View rays, the reference's shadow
  * rays and the threshold and CSSM maps' light rays walk the grid of sub-cells, crossing a brick
  * with no visible cell in one step, and take samples only in visible cells (CellWalk,
- * kernels/common.cl); host/volume.c keeps the cells' ranges. */
+ * kernels/common/common.cl); host/volume.c keeps the cells' ranges. */
 #define UMBRA_BRICK_CELLS 4
 
 /* Flags in UmbraFrame.flags. */
@@ -50,7 +50,7 @@ typedef struct UmbraFrame {
     float ground_color[4];
     float ground[4];       /* ground plane n.x + d = 0 as (n, d), n unit, facing +y */
     float value_map[4];    /* stored voxel -> normalised value: clamp((s * [2] - [0]) * [1], 0, 1)
-                              for the sampler's stored value s (kernels/sampling.cl) */
+                              for the sampler's stored value s (kernels/common/sampling.cl) */
     int32_t dims[4];       /* voxels per axis */
     int32_t bricks[4];     /* bricks per axis; [3] = brick edge in voxels */
     uint32_t width, height;
@@ -74,7 +74,7 @@ typedef struct UmbraFrame {
 
 /* Per-technique shadow parameters. One struct for all techniques keeps the ray caster's
  * signature fixed; each technique uses the fields it documents. The ls_* fields describe the
- * light-space map (host/lightspace.c fills them, kernels/lightspace.cl reads them). */
+ * light-space map (host/lightspace.c fills them, kernels/common/lightspace.cl reads them). */
 typedef struct UmbraShadow {
     float ls_u[4], ls_v[4], ls_w[4]; /* light basis: u, v across the map, w along the light */
     float ls_origin[4];       /* point light position */

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/lightspace.cl: the light-space map projection shared by the shadow-map techniques.
- * host/lightspace.c fits it to the volume's box; see UMBRA_LS_* in umbra_shared.h.
+/* kernels/common/lightspace.cl: the light-space map projection shared by the shadow-map techniques.
+ * host/lightspace.c fits it to the volume's box; see UMBRA_LS_* in common/umbra_shared.h.
  *
  * Map coordinates: x, y in texels (texel i covers [i, i+1)), depth in [0,1] between the box's
  * nearest and farthest points along the light. Orthographic depth is the distance along the light

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/shadow_deep.c: the deep shadow map (Hadwiger et al. 2006, after Lokovic and Veach 2000),
- * host side. kernels/shadow_deep.cl has the algorithm; this module owns its device memory:
+/* host/techniques/deep.c: the deep shadow map (Hadwiger et al. 2006, after Lokovic and Veach 2000),
+ * host side. kernels/techniques/deep.cl has the algorithm; this module owns its device memory:
  *
  *   - the pre-compressed segment table (256 x 256 entries of 4 nodes), cached by what it depends
  *     on -- the light transfer function, the light step, the number of light channels and the
@@ -15,8 +15,8 @@
  * Memory reported: used blocks x block bytes + the layout (heads, used blocks' next indices,
  * counts) + the table; for a fixed budget map_size^2 x N x node bytes + the table.
  *
- * The build kernels live in kernels/shadow_deep.cl next to the lookup (the fixed-budget one in
- * kernels/shadow_deep_budget.cl) but are compiled only into the build program
+ * The build kernels live in kernels/techniques/deep.cl next to the lookup (the fixed-budget one in
+ * kernels/techniques/deep_budget.cl) but are compiled only into the build program
  * (DEEP_BUILD_KERNELS), not into every ray caster program. */
 #include <math.h>
 #include <stdio.h>
@@ -24,7 +24,7 @@
 #include <string.h>
 
 #include "lightspace.h"
-#include "shadow_deep.h"
+#include "techniques/deep.h"
 
 typedef struct deep_state {
     cl_program program;             /* owned by the context's cache */
@@ -132,7 +132,7 @@ static umbra_status create_buffer(umbra_context ctx, size_t bytes, const char *w
     return UMBRA_SUCCESS;
 }
 
-/* The build program (kernels/shadow_deep.cl with its build kernels switched on, without the ray
+/* The build program (kernels/techniques/deep.cl with its build kernels switched on, without the ray
  * caster, so it does not depend on how the renderer assembles that one; the pre-filter's ray
  * count compiled in, DEEP_SUB_RAYS), its three kernels, and the tile edge the build's
  * work-group size allows. */
@@ -140,8 +140,9 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", "shadow_deep.cl",
-                           "shadow_deep_budget.cl"};
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/lightspace.cl",
+                           "techniques/deep.cl",
+                           "techniques/deep_budget.cl"};
     char options[300];
     cl_program program;
     umbra__build_options(r, options, sizeof options - 48);
@@ -501,7 +502,7 @@ static void deep_destroy(umbra_renderer r)
 
 const umbra__technique umbra__technique_deep = {
     .id = UMBRA_SHADOW_DEEP,
-    .kernel_file = "shadow_deep.cl",
+    .kernel_file = "techniques/deep.cl",
     .light_step = deep_light_step,
     .validate = deep_validate,
     .build = deep_build,

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/preintegration.cl: pre-integration tables (Engel, Kraus & Ertl 2001) and their lookup,
- * shared by the convolution shadows (kernels/convolution.cl) and the ray caster's pre-integrated
+/* kernels/common/preintegration.cl: pre-integration tables (Engel, Kraus & Ertl 2001) and their
+ * lookup,
+ * shared by the convolution shadows (kernels/techniques/convolution.cl) and the ray caster's
+ * pre-integrated
  * mode (kernels/raycast.cl).
  *
  * An entry (i, j) describes one segment of length L voxels along which the scalar runs linearly
@@ -9,7 +11,8 @@
  *                 (emission-absorption, alpha per voxel as everywhere in umbra);
  *   PREINT_LIGHT  (T, 0): the per-channel transmittance of the shading model through the segment,
  *                 the product of (1 - a)^(len (1 - t_c)) over its sub-steps (t = 0 unless
- *                 colored; kernels/common.cl): the light attenuation with pre-integrated opacity
+ *                 colored; kernels/common/common.cl): the light attenuation with pre-integrated
+ *                 opacity
  *                 that the convolution paper proposes.
  * The integral is evaluated numerically at the table's own resolution: the value interval between
  * two grid values is one "unit", and a segment spanning d = |j - i| units is d sub-steps of length
@@ -19,7 +22,8 @@
  * 256 x 256 table to a few tens of milliseconds on a CPU device. No formula divides by s_b - s_f,
  * so s_f = s_b (d = 0) needs no special case beyond taking one sample at s_f whose alpha is
  * corrected for the whole length: exactly the step-corrected transfer function. A constant
- * stretch of the transfer function gives the exact 1 - (1 - a)^L for any d. It follows common.cl
+ * stretch of the transfer function gives the exact 1 - (1 - a)^L for any d. It follows
+ * common/common.cl
  * (tf_lookup). Rows are indexed by s_b, columns by s_f: table[j * size + i]. */
 
 #define PREINT_VIEW 0u
@@ -32,7 +36,7 @@ inline float4 preint_substep(__global const float4 *tf, uint tf_size, float s, f
     float4 c = tf_lookup(tf, tf_size, s);
     if (kind == PREINT_VIEW)
         return (float4)(c.xyz, alpha_for_length(c.w, len));
-    /* light_pass of kernels/common.cl, with the transmission mode as an argument */
+    /* light_pass of kernels/common/common.cl, with the transmission mode as an argument */
     return (float4)(exp(-(tf_extinction(c.w) * len) * (colored ? 1.0f - c.xyz : (float3)(1.0f))),
                     0.0f);
 }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_none.cl: the "none" shadow technique: every point is fully lit.
+/* kernels/techniques/none.cl: the "none" shadow technique: every point is fully lit.
  *
  * The shadow-technique interface, which every kernels/shadow_*.cl file implements:
  *   SHADOW_KERNEL_PARAMS    extra kernel parameters, each with a leading comma (may be empty);

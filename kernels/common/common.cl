@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/common.cl: math shared by every umbra program: ray-box intersection, transfer-function
+/* kernels/common/common.cl: math shared by every umbra program: ray-box intersection,
+ * transfer-function
  * lookup, the counter-based random numbers, and the brick walk used for empty-space skipping.
- * It follows umbra_shared.h and precedes sampling.cl in every program. */
+ * It follows common/umbra_shared.h and precedes common/sampling.cl in every program. */
 
 #define UMBRA_INF INFINITY
 
@@ -19,7 +20,8 @@ typedef struct VolGeom {
     int3 bricks;
     int brick_size;
     int cell_size; /* voxels along a brick's sub-cell: ceil(brick_size / UMBRA_BRICK_CELLS) */
-    float value_lo, value_scale, image_scale; /* UmbraFrame.value_map (kernels/sampling.cl) */
+    float value_lo, value_scale, image_scale; /* UmbraFrame.value_map (kernels/common/sampling.cl)
+    */
 } VolGeom;
 
 inline VolGeom vol_geom(__global const UmbraFrame *F)
@@ -138,7 +140,8 @@ inline int next_sample_after(float t0, float h, float offset, float t_exit, int 
 }
 
 /* ---- a ray's walk over the bricks' sub-cells ----------------------------------------------------
- * A 3D DDA (Amanatides & Woo 1987) in voxel coordinates over the cells of kernels/umbra_shared.h:
+ * A 3D DDA (Amanatides & Woo 1987) in voxel coordinates over the cells of
+ * kernels/common/umbra_shared.h:
  * along each axis, brick b's cell j covers the positions [b B + j C, b B + min((j + 1) C, B)),
  * C = ceil(B / UMBRA_BRICK_CELLS), and the border cells reach on to infinity, as the clamped
  * sampler repeats the border voxels there. Each step crosses one face, found by comparing three

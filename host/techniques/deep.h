@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/shadow_deep.h: the deep shadow map technique (host/shadow_deep.c, kernels/shadow_deep.cl)
+/* host/techniques/deep.h: the deep shadow map technique (host/techniques/deep.c,
+ * kernels/techniques/deep.cl)
  * and the internals its tests look at: the block layout, the pool and the lookup-table cache. */
 #ifndef UMBRA_SHADOW_DEEP_H
 #define UMBRA_SHADOW_DEEP_H
 
 #include "renderer_internal.h"
 
-/* Must match kernels/shadow_deep.cl. */
+/* Must match kernels/techniques/deep.cl. */
 #define UMBRA__DEEP_LUT_RES 256u     /* quantised scalars per table axis */
 #define UMBRA__DEEP_LUT_NODES 4u     /* nodes per table entry: 3 interior + the end */
 

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_deep_budget.cl: the deep shadow map with a fixed node budget (shadow max_nodes,
- * `--nodes N`): deep_build_fixed marches every texel like deep_build (kernels/shadow_deep.cl,
+/* kernels/techniques/deep_budget.cl: the deep shadow map with a fixed node budget (shadow
+ * max_nodes,
+ * `--nodes N`): deep_build_fixed marches every texel like deep_build (kernels/techniques/deep.cl,
  * whose fit and march this file uses; the host's build program appends it after that file) and
  * keeps at most N nodes per texel in a flat array of map_size^2 x N nodes, for comparisons at
  * equal memory as in the CSSM paper. The deep map paper stores every node; how to choose N of
- * them is ours (below). The lookup is shadow_deep.cl's. */
+ * them is ours (below). The lookup is techniques/deep.cl's. */
 
 /* Fixed budget: at most N = max_nodes nodes per texel. The march and the greedy fit run as
  * in deep_build (within epsilon) into a private buffer; at the end of the ray the buffer is
@@ -31,7 +32,7 @@
  * exact choice (dynamic programming, O(N M^3) for M buffered nodes) the buffer is cut the same
  * way to DEEP_FIXED_DP nodes. N >= DEEP_FIXED_DP keeps the greedy cut.
  * Unused slots repeat the last node; a texel without attenuation stores (0, 1). */
-#define DEEP_FIXED_BUF 64 /* the largest max_nodes host/shadow_deep.c accepts */
+#define DEEP_FIXED_BUF 64 /* the largest max_nodes host/techniques/deep.c accepts */
 #define DEEP_FIXED_DP 24
 
 /* Per buffered node also its optical depth tau and sqrt(v), the two factors of the error's

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/convolution.cl: slice-based convolution shadows: Instant Convolution Shadows (ICS,
+/* kernels/techniques/convolution.cl: slice-based convolution shadows: Instant Convolution Shadows
+ * (ICS,
  * Patel et al. 2009) with the pre-integration and supersampling of "Pre-integration and
- * supersampling for convolution shadows" (the seed paper). It follows common.cl, sampling.cl and
- * preintegration.cl. The host side is host/shadow_convolution.c.
+ * supersampling for convolution shadows" (the seed paper). It follows common/common.cl,
+ * common/sampling.cl and
+ * common/preintegration.cl. The host side is host/techniques/convolution.c.
  *
  * The volume is cut by planes perpendicular to the view direction ("slices"), slice i at depth
  * z_i = z0 + i dz (depth = distance along the unit view direction from the eye, or from the view

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/shadow_convolution.c: the "convolution" technique: Instant Convolution Shadows with the
+/* host/techniques/convolution.c: the "convolution" technique: Instant Convolution Shadows with the
  * seed paper's pre-integration and supersampling (ICS, pre-integrated ICS, SCS, pre-integrated
  * SCS, chosen by desc->subsamples and desc->preintegrated). It renders the frame itself with
- * view-aligned slices (kernels/convolution.cl explains the algorithm); this file places the
+ * view-aligned slices (kernels/techniques/convolution.cl explains the algorithm); this file places
+ * the
  * slices, checks the light, keeps the buffers and enqueues one kernel per slice.
  *
  * Supported lights: light must cross the slices in the order they are composited (front to
@@ -22,7 +23,7 @@
 #include <string.h>
 
 #include "preintegration.h"
-#include "shadow_convolution.h"
+#include "techniques/convolution.h"
 
 #define CONV_MAX_SLICES 65536u
 
@@ -261,7 +262,8 @@ static umbra_status ensure_state(umbra_renderer r, uint32_t w, uint32_t h)
     }
     char options[256];
     umbra__build_options(r, options, sizeof options);
-    const char *files[] = {"common.cl", "sampling.cl", "preintegration.cl", "convolution.cl"};
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/preintegration.cl",
+                           "techniques/convolution.cl"};
     cl_program program;
     if ((st = umbra__program_get(ctx, files, 4, options, &program)) != UMBRA_SUCCESS)
         return st;
@@ -504,7 +506,8 @@ umbra_status umbra__convolution_subsample_weights(umbra_context ctx, uint32_t n,
     cl_kernel k = NULL;
     cl_mem buf = NULL;
     cl_program program;
-    const char *files[] = {"common.cl", "sampling.cl", "preintegration.cl", "convolution.cl"};
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/preintegration.cl",
+                           "techniques/convolution.cl"};
     if ((st = umbra__program_get(ctx, files, 4, "", &program)) != UMBRA_SUCCESS)
         return st;
     if ((st = umbra__kernel_create(ctx, program, "convolution_subsample_weights", &k)))

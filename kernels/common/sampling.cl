@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/sampling.cl: the one volume-sampling function, with two back ends chosen per device at
+/* kernels/common/sampling.cl: the one volume-sampling function, with two back ends chosen per
+ * device at
  * build time (UMBRA_SAMPLER_IMAGE): a buffer with hand-written trilinear interpolation (fastest on
  * PoCL's CPU device) or a 3D image with the sampler's linear filtering (texture hardware on GPUs).
  * Both clamp to the border voxels and put voxel centres at integer voxel coordinates, so they
@@ -233,7 +234,8 @@ inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * as all six share p's fractions, each axis' component is the trilinear interpolation, over p's
  * cell, of the voxels' central differences v[i+1] - v[i-1]. Six separate samples cost 48 loads
  * and six index computations: on PoCL a shaded 256^2 bonsai frame took 1.38x the unshaded one
- * with them, 1.23-1.29x with this (both with kernels/common.cl's shading_power; frames of one
+ * with them, 1.23-1.29x with this (both with kernels/common/common.cl's shading_power; frames of
+ * one
  * run each, on a loaded 2-core machine). Indices come from the unclamped position and are
  * clamped one by one, which repeats the border voxels exactly as clamping each sample's
  * position does (a position clamped to the border interpolates between two copies of the

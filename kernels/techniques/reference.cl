@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_reference.cl: the exact reference. From every point, a shadow ray is marched
+/* kernels/techniques/reference.cl: the exact reference. From every point, a shadow ray is marched
  * toward the light with step S->step and the optical depth of the shading model (the extinction
- * per channel of kernels/common.cl) is integrated. Every other technique is measured against it.
+ * per channel of kernels/common/common.cl) is integrated. Every other technique is measured against
+ * it.
  *
  * Quadrature. The path [t_start, t_end] inside the volume (and before a point light) is split
  * into whole steps h plus one final partial step; the volume is sampled at the ends of every

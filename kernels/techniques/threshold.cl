@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/shadow_threshold.cl: the opacity-threshold shadow map ("traditional shadow mapping,
+/* kernels/techniques/threshold.cl: the opacity-threshold shadow map ("traditional shadow mapping,
  * where a thresholding at opacity 0.5 is applied", as the CSSM paper compares against).
  *
  * threshold_build marches each texel's light ray (through the texel centre) and stores the
@@ -10,7 +10,7 @@
  * offsets (PCF), so that its softness compares fairly with CSSM's.
  *
  * The march: whole steps of S->step plus one partial step, each sampled at its midpoint, its
- * opacity that of the extinction of kernels/common.cl over the segment's length, empty cells
+ * opacity that of the extinction of kernels/common/common.cl over the segment's length, empty cells
  * skipped. Within the
  * segment where the threshold is crossed the medium is taken as homogeneous and the crossing
  * solved for exactly, 1 - (1 - A)(1 - a)^(x / L) = threshold, so a homogeneous slab gives the
@@ -85,7 +85,8 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
                     }
                     tau = -h_vox * log(P);
                 }
-                /* The segment's optical depth (kernels/common.cl: extinction of the interpolated
+                /* The segment's optical depth (kernels/common/common.cl: extinction of the
+                 * interpolated
                  * alpha over seg / h steps of h_vox voxels). */
                 const float od = tf_extinction(c.w) * h_vox * (seg / h);
                 if (tau + od > tau_thr) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/shadow_maps.c: the two single-layer light-space shadow maps, which share everything but
- * their kernels: the opacity-threshold map ("threshold", kernels/shadow_threshold.cl) and the
- * colored stochastic shadow map ("cssm", kernels/shadow_cssm.cl, Weidner & Linsen).
+/* host/techniques/maps.c: the two single-layer light-space shadow maps, which share everything but
+ * their kernels: the opacity-threshold map ("threshold", kernels/techniques/threshold.cl) and the
+ * colored stochastic shadow map ("cssm", kernels/techniques/cssm.cl, Weidner & Linsen).
  *
  * Both store a fixed number of floats per texel of a map_size^2 map fitted to the volume's box
  * (host/lightspace.c): the threshold map one depth, the CSSM one depth per simulated light channel
@@ -30,7 +30,7 @@ typedef struct map_kind {
 static const map_kind threshold_kind = {"threshold_build", 0};
 static const map_kind cssm_kind = {"cssm_build", 1};
 
-/* The CSSM block whose photons share a light ray (kernels/shadow_cssm.cl), B x B texels: by
+/* The CSSM block whose photons share a light ray (kernels/techniques/cssm.cl), B x B texels: by
  * default B is the map's whole texels per voxel, at most UMBRA_CSSM_MAX_RAY_BLOCK, so that a
  * block never spans more than a voxel of the box as the light sees it. */
 static uint32_t cssm_ray_block(double texels_per_voxel)
@@ -116,7 +116,8 @@ static umbra_status map_build(umbra_renderer r, double *ms, const map_kind *kind
 
     /* The technique's file without the ray caster: the build kernel needs only the volume
      * access and the projection. Built once per context and options (the context caches it). */
-    const char *files[] = {"common.cl", "sampling.cl", "lightspace.cl", r->tech->kernel_file};
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/lightspace.cl",
+                           r->tech->kernel_file};
     char options[256];
     cl_program program;
     umbra__build_options(r, options, sizeof options);
@@ -209,7 +210,7 @@ static void map_destroy(umbra_renderer r)
 
 const umbra__technique umbra__technique_threshold = {
     .id = UMBRA_SHADOW_THRESHOLD,
-    .kernel_file = "shadow_threshold.cl",
+    .kernel_file = "techniques/threshold.cl",
     .light_step = map_light_step,
     .validate = threshold_validate,
     .build = threshold_build,
@@ -221,7 +222,7 @@ const umbra__technique umbra__technique_threshold = {
 
 const umbra__technique umbra__technique_cssm = {
     .id = UMBRA_SHADOW_CSSM,
-    .kernel_file = "shadow_cssm.cl",
+    .kernel_file = "techniques/cssm.cl",
     .light_step = map_light_step,
     .validate = cssm_validate,
     .build = cssm_build,
