@@ -46,16 +46,21 @@ UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *pat
 UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path,
                                              umbra_volume *out);
 
-/* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz) through
- * nifticlib. 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and
- * float32 are kept; int8 becomes int16; int32, uint32, int64, uint64 and float64 become float32
- * (rounded to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope
- * other than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's
- * real values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform
- * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
- * the file's units; the sform (else the qform) also places the volume in the file's world (its
- * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). The header's sizes are
- * checked against the file before the voxels are read. */
+/* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz), either byte
+ * order; umbra reads the header and the voxels itself (nifticlib gives the quaternion formula).
+ * 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and float32
+ * are kept; int8 becomes int16; int32, uint32, int64, uint64 and float64 become float32 (rounded
+ * to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope other
+ * than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's real
+ * values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform (when
+ * sform_code > 0), else the qform (qform_code > 0), else pixdim (0 read as 1), in the file's
+ * units; the sform (else the qform) also places the volume in the file's world (its
+ * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). UMBRA_ERROR_FORMAT, naming
+ * the field and its value: a sizeof_hdr other than 348 or 540, a magic other than "n+1" or
+ * "n+2" ("ni1" pairs are UMBRA_ERROR_UNSUPPORTED), a vox_offset that is not a whole number of
+ * bytes past the header, a NaN or infinite scl_slope, scl_inter, pixdim[0..3] or qform/sform
+ * number, and any float voxel (after scaling) that is not finite. The header's sizes are checked
+ * against the file before the voxels are read. */
 UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
                                                umbra_volume *out);
 
