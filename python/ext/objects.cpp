@@ -176,7 +176,8 @@ void bind_objects(nb::module_ &m)
                 d.platform_index = platform_index;
                 d.device_index = device_index;
                 d.sampler = enum_from<umbra_sampler_kind>(sampler);
-                d.cache_dir = cache_dir ? cache_dir->c_str() : nullptr;
+                d.cache_dir =
+                    cache_dir ? path_arg(*cache_dir, "umbra.Context: cache_dir") : nullptr;
                 d.use_environment = use_environment;
                 std::string message;
                 d.error_callback = [](void *user, umbra_status, const char *msg) {
@@ -214,8 +215,9 @@ void bind_objects(nb::module_ &m)
         .def(
             "load_volume",
             [](Context &c, const std::string &path) {
+                const char *p = path_arg(path, "umbra.Context.load_volume: path");
                 umbra_volume v = nullptr;
-                check(c.get(), umbra_volume_load(c.get(), path.c_str(), &v));
+                check(c.get(), umbra_volume_load(c.get(), p, &v));
                 return Volume(c.h, v);
             },
             "path"_a,
@@ -227,7 +229,8 @@ void bind_objects(nb::module_ &m)
             "load_transfer_function",
             [](Context &c, const std::string &path) {
                 umbra_transfer_function t = nullptr;
-                check(c.get(), umbra_transfer_function_load(c.get(), path.c_str(), &t));
+                const char *p = path_arg(path, "umbra.Context.load_transfer_function: path");
+                check(c.get(), umbra_transfer_function_load(c.get(), p, &t));
                 return TransferFunction(c.h, t);
             },
             "path"_a,
@@ -250,7 +253,8 @@ void bind_objects(nb::module_ &m)
                                   "pass numpy.ascontiguousarray(rgba)");
                 if (a.shape(0) > UINT32_MAX || a.shape(1) > UINT32_MAX)
                     raise_invalid("umbra.Context.write_image: image too large");
-                check(c.get(), umbra_image_write(c.get(), path.c_str(), (uint32_t)a.shape(1),
+                const char *p = path_arg(path, "umbra.Context.write_image: path");
+                check(c.get(), umbra_image_write(c.get(), p, (uint32_t)a.shape(1),
                                                  (uint32_t)a.shape(0), (const float *)a.data()));
             },
             "path"_a, "rgba"_a,
@@ -261,7 +265,9 @@ void bind_objects(nb::module_ &m)
             [](Context &c, const std::string &path) {
                 uint32_t w = 0, h = 0;
                 float *p = nullptr;
-                check(c.get(), umbra_image_read(c.get(), path.c_str(), &w, &h, &p));
+                check(c.get(), umbra_image_read(c.get(),
+                                                path_arg(path, "umbra.Context.read_image: path"),
+                                                &w, &h, &p));
                 nb::capsule owner(p, [](void *q) noexcept { std::free(q); });
                 return float_out(p, {h, w, 4}, owner);
             },
