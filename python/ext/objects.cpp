@@ -214,17 +214,29 @@ void bind_objects(nb::module_ &m)
             "The sampler back end in use (never AUTO).")
         .def(
             "load_volume",
-            [](Context &c, const std::string &path) {
+            [](Context &c, const std::string &path,
+               std::optional<std::vector<std::string>> data_roots) {
                 const char *p = path_arg(path, "umbra.Context.load_volume: path");
+                std::vector<const char *> roots; /* into data_roots, alive for the call */
+                if (data_roots)
+                    for (const std::string &r : *data_roots)
+                        roots.push_back(path_arg(r, "umbra.Context.load_volume: data_roots entry"));
+                umbra_volume_load_options o;
+                umbra_volume_load_options_init(&o);
+                o.data_roots = roots.empty() ? nullptr : roots.data();
+                o.data_root_count = roots.size();
                 umbra_volume v = nullptr;
-                check(c.get(), umbra_volume_load(c.get(), p, &v));
+                check(c.get(), umbra_volume_load_with_options(c.get(), p, &o, &v));
                 return Volume(c.h, v);
             },
-            "path"_a,
+            "path"_a, nb::kw_only(), "data_roots"_a = nb::none(),
             "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib), .mha/.mhd "
             "(MetaImage) or .dat (Voreen) through umbra_io, with the file's spacing and world "
             "transform (NRRD space directions, NIfTI sform/qform, MetaImage Offset and "
-            "TransformMatrix).")
+            "TransformMatrix). A detached data file (NRRD 'data file', MetaImage ElementDataFile, "
+            "Voreen ObjectFileName) must lie in the header's own directory (after symbolic links "
+            "and '..'), else umbra.Error ERROR_IO naming it; data_roots, a list of directories, "
+            "allows those too ('/' allows any file).")
         .def(
             "load_transfer_function",
             [](Context &c, const std::string &path) {
