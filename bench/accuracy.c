@@ -57,7 +57,7 @@ static void add_reference(config_list *L, float step, int exact)
     config *c = add_config(L, UMBRA_SHADOW_REFERENCE);
     if (!c)
         return;
-    c->desc.reference_step = step;
+    c->desc.reference.step = step;
     c->exact = exact;
     snprintf(c->label, sizeof c->label, "step %g%s", step, exact ? " (exact)" : "");
     snprintf(c->params, sizeof c->params, "reference_step=%g", step);
@@ -90,9 +90,9 @@ static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float thr
     config *c = add_config(L, UMBRA_SHADOW_THRESHOLD);
     if (!c)
         return;
-    c->desc.map_size = map;
-    c->desc.taps = taps;
-    c->desc.threshold = threshold;
+    c->desc.map.size = map;
+    c->desc.threshold.taps = taps;
+    c->desc.threshold.threshold = threshold;
     char a[16], b[16];
     snprintf(c->label, sizeof c->label, "%s, opacity %g%s", map_label(map, a), threshold,
              taps > 1 ? (taps == 7 ? ", 7 taps" : taps == 13 ? ", 13 taps" : ", 21 taps") : "");
@@ -109,14 +109,14 @@ static config *add_cssm(config_list *L, uint32_t map, uint32_t taps, uint32_t ra
     config *c = add_config(L, UMBRA_SHADOW_CSSM);
     if (!c)
         return NULL;
-    c->desc.map_size = map;
-    c->desc.taps = taps;
-    c->desc.ray_block = ray_block;
+    c->desc.map.size = map;
+    c->desc.cssm.taps = taps;
+    c->desc.cssm.ray_block = ray_block;
     char a[16], b[16];
     snprintf(c->label, sizeof c->label, "%s, %u taps%s", map_label(map, a), taps,
              ray_block == 1 ? ", a ray per texel" : "");
     snprintf(c->params, sizeof c->params, "map_size=%s;taps=%u;seed=%u%s", map_name(map, b), taps,
-             c->desc.seed, ray_block == 1 ? ";ray_block=1" : "");
+             c->desc.cssm.seed, ray_block == 1 ? ";ray_block=1" : "");
     if (map == L->headline_map && taps == 13 && ray_block == 0)
         c->headline = H_CSSM;
     return c;
@@ -128,10 +128,10 @@ static config *add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes,
     config *c = add_config(L, UMBRA_SHADOW_DEEP);
     if (!c)
         return NULL;
-    c->desc.map_size = map;
-    c->desc.epsilon = eps;
-    c->desc.max_nodes = nodes;
-    c->desc.prefilter = prefilter;
+    c->desc.map.size = map;
+    c->desc.deep.epsilon = eps;
+    c->desc.deep.max_nodes = nodes;
+    c->desc.deep.prefilter = prefilter;
     char budget[32] = "";
     if (nodes)
         snprintf(budget, sizeof budget, ", %u nodes", nodes);
@@ -152,7 +152,7 @@ static void make_draft(config *c)
 {
     if (!c)
         return;
-    c->desc.map_texels_per_voxel = 1.0f;
+    c->desc.map.texels_per_voxel = 1.0f;
     size_t n = strlen(c->label), m = strlen(c->params);
     snprintf(c->label + n, sizeof c->label - n, ", draft");
     snprintf(c->params + m, sizeof c->params - m, ";map_texels_per_voxel=1");
@@ -163,9 +163,9 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
     config *c = add_config(L, UMBRA_SHADOW_CONVOLUTION);
     if (!c)
         return;
-    c->desc.slice_distance = slice;
-    c->desc.subsamples = sub;
-    c->desc.preintegrated = pre;
+    c->desc.convolution.slice_distance = slice;
+    c->desc.convolution.subsamples = sub;
+    c->preintegrated = pre;
     const char *kind = pre ? (sub ? "pre-int. SCS" : "pre-int. ICS") : (sub ? "SCS" : "ICS");
     snprintf(c->label, sizeof c->label, "%s slice %g%s", kind,
              slice, sub ? (sub == 1 ? ", 1 sub-sample" : sub == 2 ? ", 2 sub-samples"
@@ -173,7 +173,7 @@ static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
                         : "");
     snprintf(c->params, sizeof c->params,
              "slice_distance=%g;subsamples=%u;preintegrated=%d;cone_angle=%g", slice, sub, pre,
-             c->desc.cone_angle_degrees);
+             c->desc.convolution.cone_angle_degrees);
     if (slice == 1.0f && sub == 0 && !pre)
         c->headline = H_CONV;
 }

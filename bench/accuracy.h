@@ -51,6 +51,7 @@ enum {
 
 typedef struct config {
     umbra_shadow_desc desc;
+    int preintegrated; /* umbra_render_desc.preintegrated for this setting */
     char label[96];   /* for people: "1024² 13 taps" */
     char params[160]; /* for the CSV: "map_size=1024;taps=13" */
     int headline;     /* H_* or 0 */

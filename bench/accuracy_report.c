@@ -460,7 +460,7 @@ void accuracy_write_summary(bench_run *B)
                     fprintf(f, "The reference's own uncertainty (its step %g against half of it): "
                                "RMSE %.1e, max %.1e; column \"ref ±\" below.\n\n",
                             r->cfg.desc.technique == UMBRA_SHADOW_REFERENCE
-                                ? r->cfg.desc.reference_step
+                                ? r->cfg.desc.reference.step
                                 : accuracy_exact_step(spec),
                             r->ref_unc.rmse, r->ref_unc.max_abs);
                 else
@@ -518,14 +518,15 @@ static const result *find_run(const bench_run *B, int si, umbra_shadow_technique
     for (int k = 0; k < B->result_count; ++k) {
         const result *r = &B->results[k];
         const umbra_shadow_desc *d = &r->cfg.desc;
-        if (r->scene != si || d->technique != t || d->map_size != map)
+        if (r->scene != si || d->technique != t || d->map.size != map)
             continue;
-        if (t == UMBRA_SHADOW_THRESHOLD && (d->taps != taps || d->threshold != 0.5f))
+        if (t == UMBRA_SHADOW_THRESHOLD &&
+            (d->threshold.taps != taps || d->threshold.threshold != 0.5f))
             continue;
-        if (t == UMBRA_SHADOW_CSSM && (d->taps != taps || d->ray_block != 0))
+        if (t == UMBRA_SHADOW_CSSM && (d->cssm.taps != taps || d->cssm.ray_block != 0))
             continue;
-        if (t == UMBRA_SHADOW_DEEP &&
-            (d->epsilon != eps || d->max_nodes != nodes || d->prefilter != prefilter))
+        if (t == UMBRA_SHADOW_DEEP && (d->deep.epsilon != eps || d->deep.max_nodes != nodes ||
+                                       d->deep.prefilter != prefilter))
             continue;
         return r;
     }

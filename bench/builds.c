@@ -167,13 +167,13 @@ static umbra_status renderer_for(umbra_context ctx, const umbra_scene *scene,
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = v->technique;
-    sd.map_size = n;
+    sd.map.size = n;
     if (v->technique == UMBRA_SHADOW_THRESHOLD)
-        sd.threshold = v->threshold;
+        sd.threshold.threshold = v->threshold;
     if (v->technique == UMBRA_SHADOW_THRESHOLD && v->threshold > 0.5f)
-        sd.map_step = 0.5f; /* threshold-0.99: the deep map's step, so its march is as long */
+        sd.map.step = 0.5f; /* threshold-0.99: the deep map's step, so its march is as long */
     if (v->technique == UMBRA_SHADOW_DEEP)
-        sd.max_nodes = 3; /* epsilon stays at its default, 0.02 */
+        sd.deep.max_nodes = 3; /* epsilon stays at its default, 0.02 */
     umbra_status st = umbra_renderer_create(ctx, out);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_volume(*out, scene->volume);

@@ -225,8 +225,8 @@ static umbra_shadow_desc shadow_for(umbra_shadow_technique t, uint32_t map_size,
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = t;
-    sd.map_size = map_size;
-    sd.map_texels_per_voxel = k;
+    sd.map.size = map_size;
+    sd.map.texels_per_voxel = k;
     return sd;
 }
 

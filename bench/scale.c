@@ -458,8 +458,8 @@ static void write_md(FILE *f, const row *rows, int n, const options *o, const ch
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     char map[32];
-    if (sd.map_size)
-        snprintf(map, sizeof map, "%u²", sd.map_size);
+    if (sd.map.size)
+        snprintf(map, sizeof map, "%u²", sd.map.size);
     else
         snprintf(map, sizeof map, "auto");
     fprintf(f, "# umbra-bench scale\n\n- Started: %s; umbra commit %s\n- CPU: %s\n- OpenCL device: "

@@ -46,8 +46,9 @@ static inline umbra_shadow_desc mt_shadow(umbra_shadow_technique t, uint32_t map
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = t;
-    s.map_size = map_size;
-    s.taps = taps;
+    s.map.size = map_size;
+    s.threshold.taps = taps;
+    s.cssm.taps = taps;
     return s;
 }
 
@@ -124,7 +125,7 @@ static inline void mt_check_taps_read_their_texels(umbra_context ctx,
         assert_int_equal(umbra_renderer_query_shadow(r, p, count, f), UMBRA_SUCCESS);
         double *sum = calloc(count * 3, sizeof *sum);
         assert_non_null(sum);
-        s.taps = 1;
+        s.threshold.taps = s.cssm.taps = 1;
         assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
         for (uint32_t t = 0; t < taps; ++t) {
             q = 0;
@@ -360,7 +361,7 @@ static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_des
     enum { W = 32, H = 32 };
     float img[W * H * 4];
     umbra_render_stats st;
-    const size_t texels = (size_t)shadow.map_size * shadow.map_size;
+    const size_t texels = (size_t)shadow.map.size * shadow.map.size;
     assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);

@@ -64,12 +64,12 @@ static umbra_shadow_desc deep_desc(uint32_t map_size, float map_step, float eps,
     umbra_shadow_desc d;
     umbra_shadow_desc_init(&d);
     d.technique = UMBRA_SHADOW_DEEP;
-    d.map_size = map_size;
-    d.map_step = map_step;
-    d.epsilon = eps;
-    d.lookup_table = lut;
-    d.prefilter = prefilter;
-    d.max_nodes = max_nodes;
+    d.map.size = map_size;
+    d.map.step = map_step;
+    d.deep.epsilon = eps;
+    d.deep.lookup_table = lut;
+    d.deep.prefilter = prefilter;
+    d.deep.max_nodes = max_nodes;
     return d;
 }
 
@@ -379,7 +379,7 @@ static layout read_layout(umbra_renderer r)
     memset(&L, 0, sizeof L);
     assert_int_equal(umbra__deep_get_info(r, &L.info), UMBRA_SUCCESS);
     size_t tiles = (size_t)L.info.tiles_per_row * L.info.tiles_per_row;
-    size_t texels = (size_t)r->shadow.map_size * r->shadow.map_size;
+    size_t texels = (size_t)r->shadow.map.size * r->shadow.map.size;
     L.head = malloc(tiles * sizeof *L.head);
     L.next = malloc((L.info.used_blocks + 1) * sizeof *L.next);
     L.counts = malloc(texels * sizeof *L.counts);
@@ -466,7 +466,7 @@ static void test_block_allocator_layout_and_pool_growth(void **state)
         UMBRA_TRANSMISSION_COLORED);
     const uint32_t map = 72; /* not a multiple of the tile: the last tiles are partial */
     umbra_shadow_desc d = deep_desc(map, 0.5f, 0.01f, 1, 1, 0);
-    d.block_size = 2;
+    d.deep.block_size = 2;
     set_shadow(r, d);
     build(r);
     layout big = read_layout(r);
@@ -829,7 +829,7 @@ static void test_skipping_changes_nothing(void **state)
             }
             const double mean = sum / (W * H * 4);
             printf("light %d, %s, table %d, prefilter %u: skipping on/off |diff| max %.2e, "
-                   "mean %.2e\n", l, v & 1 ? "3 nodes" : "unbounded", mode != 1, d.prefilter,
+                   "mean %.2e\n", l, v & 1 ? "3 nodes" : "unbounded", mode != 1, d.deep.prefilter,
                    worst, mean);
             if (v & 1)
                 assert_true(mean <= 1e-3);
@@ -863,7 +863,7 @@ static void test_bad_parameters(void **state)
         assert_true(test_message_contains(ctx, bad[i].needle));
     }
     umbra_shadow_desc d = deep_desc(64, 0.5f, 0.02f, 1, 1, 0);
-    d.block_size = 0;
+    d.deep.block_size = 0;
     assert_int_equal(umbra_renderer_set_shadow(r, &d), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_true(test_message_contains(ctx, "block_size 0"));
     /* The test hooks refuse another technique. */

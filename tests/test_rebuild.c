@@ -127,7 +127,7 @@ static void check_technique(const umbra_shadow_desc *sd, const char *tech)
     render(r, img[0], &size1);
     assert_int_equal(umbra_renderer_set_light(r, &l2), UMBRA_SUCCESS);
     render(r, img[1], &size2);
-    if (sd->map_size == UMBRA_MAP_SIZE_AUTO && size1 == size2)
+    if (sd->map.size == UMBRA_MAP_SIZE_AUTO && size1 == size2)
         fail_msg("%s: the auto map size did not change with the light (%u)", tech, size1);
     assert_int_equal(umbra_renderer_set_transfer_function(r, tf_b), UMBRA_SUCCESS);
     render(r, img[2], NULL);
@@ -156,7 +156,7 @@ static void test_rebuild_threshold_equals_fresh(void **state)
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = UMBRA_SHADOW_THRESHOLD;
-    sd.taps = 7;
+    sd.threshold.taps = 7;
     check_technique(&sd, "threshold");
 }
 
@@ -176,8 +176,8 @@ static void test_rebuild_deep_equals_fresh(void **state)
     umbra_shadow_desc_init(&sd);
     sd.technique = UMBRA_SHADOW_DEEP;
     check_technique(&sd, "deep");
-    sd.lookup_table = 0;
-    sd.prefilter = 5;
+    sd.deep.lookup_table = 0;
+    sd.deep.prefilter = 5;
     check_technique(&sd, "deep, no segment table, 5 sub-rays");
 }
 
@@ -187,7 +187,7 @@ static void test_rebuild_deep_budget_equals_fresh(void **state)
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = UMBRA_SHADOW_DEEP;
-    sd.max_nodes = 4;
+    sd.deep.max_nodes = 4;
     check_technique(&sd, "deep, 4 nodes");
 }
 

@@ -103,8 +103,8 @@ static void test_threshold_slab_crossing_matches_analytic(void **state)
             ctx, vol, tf, lights[li], UMBRA_TRANSMISSION_GREY);
         for (size_t ti = 0; ti < 3; ++ti) {
             umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 256, 1);
-            s.threshold = thresholds[ti];
-            s.map_step = step;
+            s.threshold.threshold = thresholds[ti];
+            s.map.step = step;
             assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
             float entry[3], dir[3];
             light_ray_into_box(&lights[li], target, entry, dir);
@@ -115,7 +115,7 @@ static void test_threshold_slab_crossing_matches_analytic(void **state)
                          thresholds[ti], flip, expect, step);
             /* Filtered: the centre tap is the median of the point-symmetric tap set. */
             for (uint32_t taps = 7; taps <= 21; taps += taps == 7 ? 6 : 8) {
-                s.taps = taps;
+                s.threshold.taps = taps;
                 assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
                 float f2 = flip_distance(r, entry, dir, 30.0f, 0.02f, 0);
                 if (!(fabsf(f2 - expect) <= step))
@@ -150,8 +150,8 @@ static void test_threshold_product_and_sum_marches_exact(void **state)
     const float target[3] = {1.3f, 0.0f, -0.7f};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 64, 1);
-        s.threshold = cases[i].threshold;
-        s.map_step = cases[i].step;
+        s.threshold.threshold = cases[i].threshold;
+        s.map.step = cases[i].step;
         assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
         float entry[3], dir[3];
         light_ray_into_box(&light, target, entry, dir);
@@ -176,7 +176,7 @@ static void test_threshold_light_transfer_function_drives_map(void **state)
     umbra_light l = test_directional_light(0, -1, 0);
     umbra_renderer r = test_renderer_transmission(ctx, vol, view, l, UMBRA_TRANSMISSION_GREY);
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 128, 1);
-    s.map_step = step; /* the bound below is this light step */
+    s.map.step = step; /* the bound below is this light step */
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     const float top[3] = {0.4f, 0.5f * MT_NY, 0.3f}, down[3] = {0, -1, 0};
     float flip = flip_distance(r, top, down, 31.0f, 0.02f, 1);
@@ -247,25 +247,25 @@ static void test_threshold_invalid_parameters_rejected(void **state)
     umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_THRESHOLD, 256, 13);
     const float bad_thr[] = {0.0f, 1.0f, -0.1f, NAN};
     for (int i = 0; i < 4; ++i) {
-        s.threshold = bad_thr[i];
+        s.threshold.threshold = bad_thr[i];
         assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
         assert_true(test_message_contains(ctx, "threshold"));
     }
-    s.threshold = 0.5f;
-    s.taps = 5;
+    s.threshold.threshold = 0.5f;
+    s.threshold.taps = 5;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_true(test_message_contains(ctx, "taps 5"));
-    s.taps = 13;
-    s.map_size = 8;
+    s.threshold.taps = 13;
+    s.map.size = 8;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_true(test_message_contains(ctx, "map_size 8"));
-    s.map_size = 16384;
+    s.map.size = 16384;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
-    s.map_size = 256;
-    s.map_step = -0.5f;
+    s.map.size = 256;
+    s.map.step = -0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_ERROR_INVALID_ARGUMENT);
     assert_true(test_message_contains(ctx, "map_step -0.5"));
-    s.map_step = 0.5f;
+    s.map.step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     umbra_context_take_error(ctx, NULL);
     umbra_renderer_release(r);

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+/* host/techniques/reference.c: the exact "reference" (kernels/techniques/reference.cl): a shadow
+ * ray marched toward the light from every sample. It keeps no structure: its light pass is the
+ * light tables the renderer keeps and the step in the shared constants. */
+#include "renderer_internal.h"
+
+static float light_step(const umbra_shadow_desc *d) { return d->reference.step; }
+
+static const umbra__param params[] = {
+    UMBRA__PARAM_KEYED(reference, step, "reference_step",
+                       .doc = "shadow-ray step", .unit = "voxels", .default_value = 0.25,
+                       .min = 0.01, .max = 64),
+};
+
+static const char *const kernel_files[] = {"techniques/reference.cl", NULL};
+
+const umbra__technique umbra__technique_reference = {
+    .info = {
+        .id = UMBRA_SHADOW_REFERENCE,
+        .name = "reference",
+        .title = "exact reference",
+        .doc = "A shadow ray marched toward the light from every sample, the shading model's "
+               "optical depth integrated along it: exact up to its step, and the yardstick of "
+               "every other technique; slow (a ray per sample).",
+        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
+                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .param_count = sizeof params / sizeof params[0],
+    },
+    .params = params,
+    .kernel_files = kernel_files,
+    .light_step = light_step,
+    .ray_name = "shadow",
+};
