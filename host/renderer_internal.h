@@ -42,9 +42,31 @@ typedef struct umbra__param {
      offsetof(umbra_shadow_desc, tech.field)}
 #define UMBRA__PARAM(tech, field, ...) UMBRA__PARAM_KEYED(tech, field, #field, __VA_ARGS__)
 
+/* A setting of a technique that `umbra-bench accuracy` sweeps (bench/accuracy.c). params is
+ * "key=value;..." (the technique's keys, "auto" for a zero_name, and umbra_render_desc's
+ * preintegrated), which the bench sets by name and writes as the setting's CSV field and image
+ * name: a setting keeps its name across runs, so recorded results stay comparable. */
+typedef struct umbra__setting {
+    const char *params;
+    const char *label; /* for people: "1024², 13 taps" */
+    uint32_t flags;    /* UMBRA__SWEEP_* */
+} umbra__setting;
+
+#define UMBRA__SWEEP_QUICK 1u          /* in the quick sweep (--quick) */
+#define UMBRA__SWEEP_FULL 2u           /* in the full sweep */
+#define UMBRA__SWEEP_PAPERS_CSSM 4u    /* full sweep, scenes marked `papers cssm` only */
+#define UMBRA__SWEEP_PAPERS_DEEP 8u    /* full sweep, scenes marked `papers deep` only */
+#define UMBRA__SWEEP_HEADLINE 16u      /* the technique's row(s) of the full sweep's headline */
+#define UMBRA__SWEEP_HEADLINE_QUICK 32u /* ... and of the quick sweep's */
+#define UMBRA__SWEEP_BUILDS 64u        /* a variant of `umbra-bench builds` (bench/builds.c),
+                                          named by its label: grey, and for a technique that is
+                                          not grey-only also coloured ("-grey", "-colored") */
+
 typedef struct umbra__technique {
     umbra_technique_info info;      /* first: umbra_technique_get returns &info */
     const umbra__param *params;     /* info.param_count of them */
+    const umbra__setting *sweep;    /* the bench's settings, sweep_count of them */
+    uint32_t sweep_count;
     /* The technique's kernel files (paths under kernels/, "techniques/cssm_shared.h",
      * "techniques/cssm.cl"), NULL-terminated, compiled after kernels/common/ and before
      * kernels/raycast.cl into the ray caster; NULL for a technique that renders the frame itself

@@ -450,6 +450,26 @@ static const umbra__param params[] = {
                  .unit = "degrees", .default_value = 5, .min = 0, .max = 60),
 };
 
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"slice_distance=0.5;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 0.5",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 1",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"slice_distance=2;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 2",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=1;preintegrated=0;cone_angle=5", "SCS slice 2, 1 sub-sample",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=0;cone_angle=5", "SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 1",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 2",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=1;cone_angle=5", "pre-int. SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+};
+
 const umbra__technique umbra__technique_convolution = {
     .info = {
         .id = UMBRA_SHADOW_CONVOLUTION,
@@ -464,6 +484,8 @@ const umbra__technique umbra__technique_convolution = {
         .param_count = sizeof params / sizeof params[0],
     },
     .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .light_step = conv_light_step,
     .render = conv_render,
     .memory = conv_memory,

@@ -80,6 +80,33 @@ static const umbra__param params[] = {
                  .max = UMBRA_CSSM_MAX_RAY_BLOCK, .zero_doc = "the map's own"),
 };
 
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"", "cssm", UMBRA__SWEEP_BUILDS}, /* 13 taps do not enter a build */
+    {"map_size=auto;taps=13;seed=1", "auto size, 13 taps",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;taps=13;seed=1", "512², 13 taps",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;taps=13;seed=1", "1024², 13 taps",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;taps=13;seed=1", "2048², 13 taps",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=4096;taps=13;seed=1", "4096², 13 taps",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=auto;taps=13;seed=1;map_texels_per_voxel=1", "auto size, 13 taps, draft",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;taps=7;seed=1", "512², 7 taps",
+     UMBRA__SWEEP_QUICK},
+    {"map_size=1024;taps=7;seed=1", "1024², 7 taps",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;taps=21;seed=1", "1024², 21 taps",
+     UMBRA__SWEEP_FULL},
+    {"map_size=auto;taps=13;seed=1;ray_block=1", "auto size, 13 taps, a ray per texel",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;taps=13;seed=1;ray_block=1", "1024², 13 taps, a ray per texel",
+     UMBRA__SWEEP_FULL},
+};
+
 static const char *const kernel_files[] = {"techniques/cssm_shared.h", "techniques/cssm.cl",
                                            NULL};
 
@@ -103,6 +130,8 @@ const umbra__technique umbra__technique_cssm = {
         .map_step = 1.0f, /* lightspace.h: its noise, not its step, sets its error */
     },
     .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = umbra__map_light_step,
     .build = build,

@@ -507,6 +507,53 @@ static const umbra__param params[] = {
                  .flags = UMBRA_PARAM_REBUILDS, .default_value = 1, .min = 0, .max = 1),
 };
 
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"max_nodes=3", "deep", UMBRA__SWEEP_BUILDS}, /* epsilon stays at its default, 0.02 */
+    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1", "auto size, ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;epsilon=0.02;max_nodes=0;prefilter=1", "512², ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;epsilon=0.02;max_nodes=0;prefilter=1", "1024², ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;epsilon=0.02;max_nodes=0;prefilter=1", "2048², ε 0.02",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1;map_texels_per_voxel=1", "auto size, ε 0.02, draft",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;epsilon=0.02;max_nodes=3;prefilter=1", "512², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;epsilon=0.02;max_nodes=3;prefilter=1", "1024², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;epsilon=0.02;max_nodes=3;prefilter=1", "2048², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=4096;epsilon=0.02;max_nodes=3;prefilter=1", "4096², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=1024;epsilon=0.02;max_nodes=2;prefilter=1", "1024², ε 0.02, 2 nodes",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.02;max_nodes=6;prefilter=1", "1024², ε 0.02, 6 nodes",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.01;max_nodes=0;prefilter=1", "1024², ε 0.01",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.06;max_nodes=0;prefilter=1", "1024², ε 0.06",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.1;max_nodes=0;prefilter=1", "1024², ε 0.1",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.02;max_nodes=0;prefilter=5", "1024², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=128;epsilon=0.02;max_nodes=0;prefilter=5", "128², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=128;epsilon=0.06;max_nodes=0;prefilter=5", "128², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=256;epsilon=0.02;max_nodes=0;prefilter=5", "256², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=256;epsilon=0.06;max_nodes=0;prefilter=5", "256², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=512;epsilon=0.02;max_nodes=0;prefilter=5", "512², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=512;epsilon=0.06;max_nodes=0;prefilter=5", "512², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+};
+
 static const char *const kernel_files[] = {"techniques/deep_shared.h", "techniques/deep.cl",
                                            NULL};
 
@@ -529,6 +576,8 @@ const umbra__technique umbra__technique_deep = {
         .map_step = 0.5f, /* lightspace.h: its nodes follow the sampled visibility */
     },
     .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = umbra__map_light_step,
     .build = deep_build,

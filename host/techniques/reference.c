@@ -12,6 +12,16 @@ static const umbra__param params[] = {
                        .min = 0.01, .max = 64),
 };
 
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"reference_step=0.5", "step 0.5",
+     UMBRA__SWEEP_FULL},
+    {"reference_step=1", "step 1",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"reference_step=2", "step 2",
+     UMBRA__SWEEP_FULL},
+};
+
 static const char *const kernel_files[] = {"techniques/reference.cl", NULL};
 
 const umbra__technique umbra__technique_reference = {
@@ -27,6 +37,8 @@ const umbra__technique umbra__technique_reference = {
         .param_count = sizeof params / sizeof params[0],
     },
     .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = light_step,
     .ray_name = "shadow",

@@ -67,6 +67,32 @@ static const umbra__param params[] = {
                  .allowed_count = 4),
 };
 
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    /* The builds' baseline, and a threshold march as long as the deep map's: stopped where the
+     * deep map's stops (visibility below epsilon / 2 = 0.01), at its step of half a voxel. */
+    {"threshold=0.5", "threshold", UMBRA__SWEEP_BUILDS},
+    {"threshold=0.99;map_step=0.5", "threshold-0.99", UMBRA__SWEEP_BUILDS},
+    {"map_size=auto;taps=1;threshold=0.5", "auto size, opacity 0.5",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;taps=1;threshold=0.5", "512², opacity 0.5",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;taps=1;threshold=0.5", "1024², opacity 0.5",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;taps=1;threshold=0.5", "2048², opacity 0.5",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=4096;taps=1;threshold=0.5", "4096², opacity 0.5",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=auto;taps=13;threshold=0.5", "auto size, opacity 0.5, 13 taps",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;taps=13;threshold=0.5", "1024², opacity 0.5, 13 taps",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;taps=1;threshold=0.25", "1024², opacity 0.25",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;taps=1;threshold=0.75", "1024², opacity 0.75",
+     UMBRA__SWEEP_FULL},
+};
+
 static const char *const kernel_files[] = {"techniques/threshold_shared.h",
                                            "techniques/threshold.cl", NULL};
 
@@ -90,6 +116,8 @@ const umbra__technique umbra__technique_threshold = {
         .map_step = 1.0f, /* lightspace.h: the step only sets where the volume is sampled */
     },
     .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = umbra__map_light_step,
     .build = build,
