@@ -476,7 +476,8 @@ int bench_accuracy(int argc, char **argv)
             printf("%s%s: %s (%s)\n", B.scenes[si].name, B.present[si] ? "" : " [volume absent]",
                    B.scenes[si].description, B.scenes[si].volume);
             for (int i = 0; i < L.count; ++i)
-                printf("  %-12s %-40s %s%s\n", umbra_shadow_technique_name(L.items[i].desc.technique),
+                printf("  %-12s %-40s %s%s\n",
+                       umbra_shadow_technique_name(L.items[i].desc.technique),
                        L.items[i].label, L.items[i].params,
                        L.items[i].headline ? " [headline]" : "");
         }

@@ -74,7 +74,8 @@ static void make_variants(void)
         for (uint32_t i = 0; i < tech->sweep_count; ++i) {
             if (!(tech->sweep[i].flags & UMBRA__SWEEP_BUILDS))
                 continue;
-            for (int colored = 0; colored <= !grey_only && variant_count < MAX_VARIANTS; ++colored) {
+            for (int colored = 0; colored <= !grey_only && variant_count < MAX_VARIANTS;
+                 ++colored) {
                 variant *v = &variants[variant_count++];
                 snprintf(v->name, sizeof v->name, "%s%s", tech->sweep[i].label,
                          grey_only ? "" : colored ? "-colored" : "-grey");

@@ -43,7 +43,8 @@ static int cell(double got, double bound, char *buf, size_t size)
     }
     const int over = !(got <= bound);
     if (bound > 0.0)
-        snprintf(buf, size, "%.1e / %.1e (%.2f)%s", got, bound, got / bound, over ? " **over**" : "");
+        snprintf(buf, size, "%.1e / %.1e (%.2f)%s", got, bound, got / bound,
+                 over ? " **over**" : "");
     else
         snprintf(buf, size, "%.1e / 0%s", got, over ? " **over**" : "");
     return over;

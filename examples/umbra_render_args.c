@@ -137,7 +137,7 @@ static int check_output(const char *path)
         return 1;                                                                              \
     } while (0)
 
-/* ---- the fixed options ------------------------------------------------------------------------ */
+/* ---- the fixed options ----------------------------------------------------------------------- */
 
 enum {
     OPT_VERSION = 256, OPT_SCENE, OPT_SCENE_SIZE, OPT_VOLUME, OPT_RAW, OPT_RAW_DIMS, OPT_RAW_TYPE,
@@ -209,7 +209,7 @@ static const fixed_option fixed[] = {
 };
 #define FIXED_COUNT (sizeof fixed / sizeof fixed[0])
 
-/* ---- the technique options, from the registry --------------------------------------------------- */
+/* ---- the technique options, from the registry ------------------------------------------------ */
 
 /* One long option for a technique parameter's key (shared by every technique with that key). */
 typedef struct param_option {
@@ -423,7 +423,7 @@ static void usage(FILE *f)
     }
 }
 
-/* ---- parsing ----------------------------------------------------------------------------------- */
+/* ---- parsing --------------------------------------------------------------------------------- */
 
 /* A technique parameter given on the command line, applied once the technique is known. */
 typedef struct given {
@@ -483,8 +483,9 @@ int parse_args(int argc, char **argv, options *o)
     struct option longopts[FIXED_COUNT + MAX_PARAM_OPTIONS + 1];
     size_t n = 0;
     for (size_t i = 0; i < FIXED_COUNT; ++i)
-        longopts[n++] = (struct option){fixed[i].name, fixed[i].arg ? required_argument : no_argument,
-                                        NULL, fixed[i].val};
+        longopts[n++] = (struct option){fixed[i].name,
+                                        fixed[i].arg ? required_argument : no_argument, NULL,
+                                        fixed[i].val};
     for (int i = 0; i < param_option_count; ++i)
         longopts[n++] = (struct option){param_options[i].name,
                                         param_options[i].type == UMBRA_PARAM_BOOL

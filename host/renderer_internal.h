@@ -30,7 +30,8 @@ typedef struct umbra__param {
 #define UMBRA__MAX_PARAMS 24
 
 /* umbra__param's type from the C field's: float, uint32_t or int (a flag). */
-#define UMBRA__PARAM_TYPE(field)                                                                   _Generic((field), float: UMBRA_PARAM_FLOAT, uint32_t: UMBRA_PARAM_UINT, int: UMBRA_PARAM_BOOL)
+#define UMBRA__PARAM_TYPE(field)                                                               \
+    _Generic((field), float: UMBRA_PARAM_FLOAT, uint32_t: UMBRA_PARAM_UINT, int: UMBRA_PARAM_BOOL)
 
 /* A parameter row of technique member `tech` (its field `field`), the rest of its
  * umbra_param_info given as designated initializers: .doc, .default_value, .min, .max, ... The
@@ -95,6 +96,9 @@ typedef struct umbra__technique {
     size_t (*memory)(umbra_renderer r);
     /* Frees r->tech_state (optional). */
     void (*destroy)(umbra_renderer r);
+    /* What shared machinery needs of the technique (optional): a single-layer map's
+     * umbra__map_kind (host/techniques/maps.h). */
+    const void *data;
 } umbra__technique;
 
 /* What a shadow structure depends on; a change of any field means a rebuild. The fields of

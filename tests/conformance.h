@@ -112,8 +112,28 @@ static inline umbra_light conf_point(float x, float y, float z)
     return l;
 }
 
-/* A float volume of nx x ny x nz voxels (unit spacing, value range [0, 1]) with voxel values
- * f(x, y, z) at the voxel centres, box-centred coordinates. */
+/* A float volume of nx x ny x nz voxels (x fastest) copied from data: unit spacing, value range
+ * [0, 1], bricks of brick_size voxels (0: umbra's default). */
+static inline umbra_status conf_volume_of(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
+                                          const float *data, uint32_t brick_size,
+                                          umbra_volume *out)
+{
+    umbra_volume_desc vd;
+    umbra_volume_desc_init(&vd);
+    vd.data = data;
+    vd.type = UMBRA_FLOAT32;
+    vd.dims[0] = nx;
+    vd.dims[1] = ny;
+    vd.dims[2] = nz;
+    vd.value_range_given = 1;
+    vd.value_min = 0.0f;
+    vd.value_max = 1.0f;
+    if (brick_size)
+        vd.brick_size = brick_size;
+    return umbra_volume_create(ctx, &vd, out);
+}
+
+/* The same with voxel values f(x, y, z) at the voxel centres, box-centred coordinates. */
 static inline umbra_status conf_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                        float (*f)(float, float, float), umbra_volume *out)
 {
@@ -125,17 +145,7 @@ static inline umbra_status conf_volume(umbra_context ctx, uint32_t nx, uint32_t 
             for (uint32_t x = 0; x < nx; ++x)
                 data[((size_t)z * ny + y) * nx + x] = f(x + 0.5f - 0.5f * nx, y + 0.5f - 0.5f * ny,
                                                         z + 0.5f - 0.5f * nz);
-    umbra_volume_desc vd;
-    umbra_volume_desc_init(&vd);
-    vd.data = data;
-    vd.type = UMBRA_FLOAT32;
-    vd.dims[0] = nx;
-    vd.dims[1] = ny;
-    vd.dims[2] = nz;
-    vd.value_range_given = 1;
-    vd.value_min = 0.0f;
-    vd.value_max = 1.0f;
-    umbra_status st = umbra_volume_create(ctx, &vd, out);
+    umbra_status st = conf_volume_of(ctx, nx, ny, nz, data, 0, out);
     free(data);
     return st;
 }
@@ -170,10 +180,12 @@ static inline umbra_status conf_tf(umbra_context ctx, const float lo[4], const f
     return umbra_transfer_function_create(ctx, rgba, 2, out);
 }
 
-/* The length of the part of p + t d, t >= 0 (d unit), inside the box [-half, half], in double. */
-static inline double conf_path_in_box(const double p[3], const double d[3], const double half[3])
+/* The length of the part of p + t d, t in [0, t_max] (d unit), inside the box [-half, half], in
+ * double: the analytic path for exp(-sigma d) checks. */
+static inline double conf_path_in_box(const double p[3], const double d[3], const double half[3],
+                                      double t_max)
 {
-    double lo = 0.0, hi = INFINITY;
+    double lo = 0.0, hi = t_max;
     for (int a = 0; a < 3; ++a) {
         if (d[a] == 0.0) {
             if (p[a] < -half[a] || p[a] > half[a])
@@ -332,7 +344,7 @@ static inline umbra_status conf_scene_make(umbra_context ctx, int c, conf_scene 
     return st != UMBRA_SUCCESS ? st : conf_points(s);
 }
 
-/* ---- rendering a case -------------------------------------------------------------------------- */
+/* ---- rendering a case ------------------------------------------------------------------------ */
 
 /* A renderer on scene s with the technique `technique` and its `params` (tests/setting.h) over
  * the defaults; the reference at CONF_FINE_STEP when technique is NULL; a transparent light
@@ -377,7 +389,7 @@ static inline umbra_status conf_renderer(umbra_context ctx, const conf_scene *s,
     return st;
 }
 
-/* ---- the measures ------------------------------------------------------------------------------ */
+/* ---- the measures ---------------------------------------------------------------------------- */
 
 /* The slab cases: the shadow factor each ground pixel shows, against the analytic one (1 with
  * unlit). mean over every pixel and channel; max over the pixels away from the shadow's edges
@@ -403,7 +415,7 @@ static inline void conf_slab_error(const conf_scene *s, const float *img, int un
         for (uint32_t x = 0; x < W; ++x) {
             const double p[3] = {((x + 0.5) / W * 2.0 - 1.0) * half_w, s->ground_y,
                                  -(1.0 - (y + 0.5) / H * 2.0) * half_h};
-            const double L = conf_path_in_box(p, d, s->half);
+            const double L = conf_path_in_box(p, d, s->half, INFINITY);
             for (int k = 0; k < 3; ++k)
                 want[3 * ((size_t)y * W + x) + k] = unlit ? 1.0 : exp(-s->sigma[k] * L);
         }
@@ -445,7 +457,7 @@ static inline double conf_mean_abs(const float *a, const float *b, size_t n, siz
     return sum / (3.0 * n);
 }
 
-/* ---- the bounds ------------------------------------------------------------------------------------ */
+/* ---- the bounds ------------------------------------------------------------------------------ */
 
 typedef struct conf_row {
     const char *technique; /* its registry name */

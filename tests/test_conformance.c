@@ -25,20 +25,14 @@
 #include "renderer_internal.h"
 #include "test_util.h"
 
+/* The group's context (test_group_setup), for the helpers below. */
 static umbra_context ctx;
 
 static int setup(void **state)
 {
-    (void)state;
-    ctx = test_context();
-    return ctx ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    umbra_context_release(ctx);
-    return 0;
+    int rc = test_group_setup(state);
+    ctx = *state;
+    return rc;
 }
 
 static const char *row_name(const conf_row *row, char *buf, size_t size)
@@ -57,7 +51,8 @@ static void test_conformance_every_technique_has_rows(void **state)
         for (size_t i = 0; i < CONF_ROWS; ++i)
             rows += strcmp(conf_rows[i].technique, umbra_technique_get(t)->name) == 0;
         if (!rows)
-            fail_msg("technique '%s' has no row in tests/conformance.h", umbra_technique_get(t)->name);
+            fail_msg("technique '%s' has no row in tests/conformance.h",
+                     umbra_technique_get(t)->name);
     }
     for (size_t i = 0; i < CONF_ROWS; ++i)
         if (!umbra_technique_find(conf_rows[i].technique))
@@ -131,7 +126,7 @@ static void test_conformance_cases_within_bounds(void **state)
         fail_msg("%d conformance check(s) failed (listed above)", failures);
 }
 
-/* ---- rebuild equals fresh ---------------------------------------------------------------------- */
+/* ---- rebuild equals fresh -------------------------------------------------------------------- */
 
 enum { RB_NX = 40, RB_NY = 32, RB_NZ = 36, RB_W = 48, RB_H = 40 };
 
@@ -263,7 +258,7 @@ static void test_conformance_rebuild_equals_fresh(void **state)
     umbra_volume_release(vol);
 }
 
-/* ---- bad parameters ------------------------------------------------------------------------------ */
+/* ---- bad parameters -------------------------------------------------------------------------- */
 
 /* Values param p refuses: below and above its range, NaN (floats), a value between two of its
  * set; the count. */
@@ -374,7 +369,7 @@ static void test_conformance_bad_parameters_refused_by_name(void **state)
     umbra_renderer_release(r);
 }
 
-/* ---- what rebuilds ------------------------------------------------------------------------------- */
+/* ---- what rebuilds --------------------------------------------------------------------------- */
 
 /* Another valid value of p (the next of its set, or a step inside its range). */
 static double other_value(const umbra_param_info *p, double v)
@@ -472,5 +467,5 @@ int main(int argc, char **argv)
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, setup, test_group_teardown);
 }

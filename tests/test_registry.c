@@ -197,7 +197,7 @@ static void test_registry_set_and_get_by_name(void **state)
                      UMBRA_ERROR_INVALID_ARGUMENT);
 }
 
-/* ---- older layouts ----------------------------------------------------------------------------- */
+/* ---- older layouts --------------------------------------------------------------------------- */
 
 /* umbra 0.4's public umbra_shadow_desc, as an application built against 0.4 fills it. */
 typedef struct shadow_desc_0_4 {
@@ -222,6 +222,12 @@ static shadow_desc_0_4 old_defaults(umbra_shadow_technique t)
     shadow_desc_0_4 o = {sizeof(shadow_desc_0_4), t, 0.25f, 0, 0.0f, 0.0f, 0.5f, 13, 0.02f, 0,
                          8, 1, 1, 1, 0, 0.5f, 0, 0, 5.0f};
     return o;
+}
+
+/* An old desc where the new API takes a new one: what a 0.4 binary passes. */
+static const umbra_shadow_desc *as_0_5(const shadow_desc_0_4 *old)
+{
+    return (const umbra_shadow_desc *)(const void *)old;
 }
 
 static void render_with(umbra_renderer r, const void *shadow, const void *options, float *img)
@@ -257,7 +263,7 @@ static void test_registry_layout_0_4_accepted(void **state)
     render_with(r, &old, &o_0_4, a);
     render_with(r, &d, &o, b);
     assert_memory_equal(a, b, sizeof a);
-    /* Convolution, pre-integrated through the 0.4 shadow desc, whichever order the calls come in. */
+    /* Convolution, pre-integrated through the 0.4 shadow desc, in either order of the calls. */
     old = old_defaults(UMBRA_SHADOW_CONVOLUTION);
     old.slice_distance = 1.0f;
     old.preintegrated = 1;
@@ -265,7 +271,7 @@ static void test_registry_layout_0_4_accepted(void **state)
     assert_int_equal(umbra_renderer_set_light(r, &front), UMBRA_SUCCESS);
     render_with(r, &old, &o_0_4, a);
     assert_int_equal(r->opts.preintegrated, 1);
-    assert_int_equal(umbra_renderer_set_shadow(r, (const umbra_shadow_desc *)(const void *)&old), UMBRA_SUCCESS);
+    assert_int_equal(umbra_renderer_set_shadow(r, as_0_5(&old)), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_set_options(r, &o_0_4), UMBRA_SUCCESS);
     assert_int_equal(r->opts.preintegrated, 1); /* 0.4's options leave it */
     umbra_shadow_desc_init(&d);
@@ -280,8 +286,8 @@ static void test_registry_layout_0_4_accepted(void **state)
     /* A 0.4 value out of range is refused by its new name. */
     old = old_defaults(UMBRA_SHADOW_DEEP);
     old.prefilter = 3;
-    test_assert_failed(ctx, umbra_renderer_set_shadow(r, (const umbra_shadow_desc *)(const void *)&old), UMBRA_ERROR_INVALID_ARGUMENT,
-                       "deep prefilter 3", NULL);
+    test_assert_failed(ctx, umbra_renderer_set_shadow(r, as_0_5(&old)),
+                       UMBRA_ERROR_INVALID_ARGUMENT, "deep prefilter 3", NULL);
     /* Other sizes are refused. */
     umbra_shadow_desc_init(&d);
     d.struct_size = sizeof d - 4;

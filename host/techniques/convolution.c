@@ -180,7 +180,8 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
     if (n > CONV_MAX_SLICES)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: slice_distance %g voxels needs %.0f slices over a depth of %g "
-                           "voxels; at most %u are allowed", fn, r->shadow.convolution.slice_distance, n,
+                           "voxels; at most %u are allowed", fn,
+                           r->shadow.convolution.slice_distance, n,
                            (z_end - G->z0) / umbra__voxel_world(r), CONV_MAX_SLICES);
     G->slices = (uint32_t)n;
     G->rect[0] = 0;
@@ -466,7 +467,8 @@ static const umbra__setting sweep[] = {
      UMBRA__SWEEP_FULL},
     {"slice_distance=2;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 2",
      UMBRA__SWEEP_FULL},
-    {"slice_distance=2;subsamples=3;preintegrated=1;cone_angle=5", "pre-int. SCS slice 2, 3 sub-samples",
+    {"slice_distance=2;subsamples=3;preintegrated=1;cone_angle=5",
+     "pre-int. SCS slice 2, 3 sub-samples",
      UMBRA__SWEEP_FULL},
 };
 
@@ -479,8 +481,7 @@ const umbra__technique umbra__technique_convolution = {
                "light from slice to slice through a blur kernel: soft shadows at the cost of a "
                "kernel launch per slice every frame, for lights on the viewer's side only.",
         .flags = UMBRA_TECHNIQUE_FRAME,
-        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
-                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
     },
     .params = params,

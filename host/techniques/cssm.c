@@ -51,21 +51,12 @@ static const umbra__map_kind kind = {
     .lookup_constants = lookup_constants,
 };
 
-static umbra_status build(umbra_renderer r, double *ms) { return umbra__map_build(r, ms, &kind); }
-
-static umbra_status bind(umbra_renderer r, cl_kernel k, cl_uint first)
-{
-    return umbra__map_bind(r, k, first, &kind);
-}
-
-static const double taps_set[] = {1, 7, 13, 21};
-
 static const umbra__param params[] = {
     UMBRA__MAP_PARAMS,
     UMBRA__PARAM(cssm, taps,
                  .doc = "texels averaged per lookup (13: the paper's set): more taps reach "
                         "farther (radius 4, 7, 10 for 7, 13, 21), trading noise for a wider blur",
-                 .default_value = 13, .min = 1, .max = 21, .allowed = taps_set,
+                 .default_value = 13, .min = 1, .max = 21, .allowed = umbra__map_taps,
                  .allowed_count = 4),
     UMBRA__PARAM(cssm, seed,
                  .doc = "seed of the counter-based random numbers: the same seed gives the same "
@@ -120,8 +111,7 @@ const umbra__technique umbra__technique_cssm = {
                "shadows in 4 or 12 bytes per texel, at the price of noise that the taps "
                "average.",
         .flags = UMBRA_TECHNIQUE_MAP,
-        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
-                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* The lookup averages taps fixed in texels (radius 4 for 13 taps): at one texel per
          * voxel it blurs shadows over 4 voxels; at three its error is within 5% of a 1024^2
@@ -134,8 +124,9 @@ const umbra__technique umbra__technique_cssm = {
     .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = umbra__map_light_step,
-    .build = build,
-    .bind = bind,
+    .build = umbra__map_build,
+    .bind = umbra__map_bind,
     .memory = umbra__map_memory,
     .destroy = umbra__map_destroy,
+    .data = &kind,
 };

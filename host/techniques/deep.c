@@ -518,7 +518,8 @@ static const umbra__setting sweep[] = {
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
     {"map_size=2048;epsilon=0.02;max_nodes=0;prefilter=1", "2048², ε 0.02",
      UMBRA__SWEEP_PAPERS_CSSM},
-    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1;map_texels_per_voxel=1", "auto size, ε 0.02, draft",
+    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1;map_texels_per_voxel=1",
+     "auto size, ε 0.02, draft",
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
     {"map_size=512;epsilon=0.02;max_nodes=3;prefilter=1", "512², ε 0.02, 3 nodes",
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_HEADLINE_QUICK},
@@ -567,8 +568,7 @@ const umbra__technique umbra__technique_deep = {
                "to the reference on translucent and coloured material; memory grows with the "
                "function's nodes (or is fixed by a node budget).",
         .flags = UMBRA_TECHNIQUE_MAP,
-        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
-                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* A nearest-texel lookup: its error keeps falling with the size; two texels per voxel
          * halve the error of one (walnut: 0.0018 to 0.0010) for under half the rays of three. */

@@ -26,8 +26,11 @@ static map_state *state_get(umbra_renderer r)
     return r->tech_state;
 }
 
-umbra_status umbra__map_build(umbra_renderer r, double *ms, const umbra__map_kind *kind)
+const double umbra__map_taps[4] = {1, 7, 13, 21};
+
+umbra_status umbra__map_build(umbra_renderer r, double *ms)
 {
+    const umbra__map_kind *kind = r->tech->data;
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     map_state *s = state_get(r);
@@ -97,9 +100,9 @@ fail:
     return st;
 }
 
-umbra_status umbra__map_bind(umbra_renderer r, cl_kernel k, cl_uint first,
-                             const umbra__map_kind *kind)
+umbra_status umbra__map_bind(umbra_renderer r, cl_kernel k, cl_uint first)
 {
+    const umbra__map_kind *kind = r->tech->data;
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     map_state *s = r->tech_state;

@@ -27,13 +27,16 @@ typedef struct umbra__map_kind {
     void (*lookup_constants)(umbra_renderer r, void *constants);
 } umbra__map_kind;
 
-/* The technique functions of a single-layer map of kind `kind`: build, bind (the constants and
- * the map, in that order, after the fixed arguments), memory and destroy. */
-umbra_status umbra__map_build(umbra_renderer r, double *ms, const umbra__map_kind *kind);
-umbra_status umbra__map_bind(umbra_renderer r, cl_kernel k, cl_uint first,
-                             const umbra__map_kind *kind);
+/* The technique functions of a single-layer map, whose descriptor's data is its umbra__map_kind:
+ * build, bind (the constants and the map, in that order, after the fixed arguments), memory and
+ * destroy. */
+umbra_status umbra__map_build(umbra_renderer r, double *ms);
+umbra_status umbra__map_bind(umbra_renderer r, cl_kernel k, cl_uint first);
 size_t umbra__map_memory(umbra_renderer r);
 void umbra__map_destroy(umbra_renderer r);
+
+/* The tap counts of a filtered lookup (kernels/common/lightspace.cl's offsets): 1, 7, 13, 21. */
+extern const double umbra__map_taps[4];
 
 /* The kernel constants the last build or lookup used (tests read them): constants_size bytes,
  * or NULL before the first build. */

@@ -32,8 +32,7 @@ const umbra__technique umbra__technique_reference = {
         .doc = "A shadow ray marched toward the light from every sample, the shading model's "
                "optical depth integrated along it: exact up to its step, and the yardstick of "
                "every other technique; slow (a ray per sample).",
-        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
-                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
     },
     .params = params,

@@ -44,15 +44,6 @@ static const umbra__map_kind kind = {
     .lookup_constants = lookup_constants,
 };
 
-static umbra_status build(umbra_renderer r, double *ms) { return umbra__map_build(r, ms, &kind); }
-
-static umbra_status bind(umbra_renderer r, cl_kernel k, cl_uint first)
-{
-    return umbra__map_bind(r, k, first, &kind);
-}
-
-static const double taps_set[] = {1, 7, 13, 21};
-
 static const umbra__param params[] = {
     UMBRA__MAP_PARAMS,
     UMBRA__PARAM(threshold, threshold,
@@ -63,7 +54,7 @@ static const umbra__param params[] = {
     UMBRA__PARAM(threshold, taps,
                  .doc = "texels averaged per lookup (percentage-closer filtering at CSSM's tap "
                         "offsets)",
-                 .default_value = 13, .min = 1, .max = 21, .allowed = taps_set,
+                 .default_value = 13, .min = 1, .max = 21, .allowed = umbra__map_taps,
                  .allowed_count = 4),
 };
 
@@ -107,8 +98,7 @@ const umbra__technique umbra__technique_threshold = {
                "the transmission colour and turns translucent material's partial shadows into "
                "full ones.",
         .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_GREY,
-        .rebuilt_by = UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |
-                      UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* One depth per texel: a texel per voxel resolves what the volume holds (finer maps
          * sample the same voxels again). */
@@ -120,8 +110,9 @@ const umbra__technique umbra__technique_threshold = {
     .sweep_count = sizeof sweep / sizeof sweep[0],
     .kernel_files = kernel_files,
     .light_step = umbra__map_light_step,
-    .build = build,
-    .bind = bind,
+    .build = umbra__map_build,
+    .bind = umbra__map_bind,
     .memory = umbra__map_memory,
     .destroy = umbra__map_destroy,
+    .data = &kind,
 };

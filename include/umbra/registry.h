@@ -82,6 +82,10 @@ typedef struct umbra_param_info {
 #define UMBRA_REBUILD_VOLUME 4u       /* umbra_renderer_set_volume */
 #define UMBRA_REBUILD_TRANSMISSION 8u /* umbra_render_desc.transmission */
 #define UMBRA_REBUILD_SKIPPING 16u    /* umbra_render_desc.empty_space_skipping */
+/* All of them: a structure built from the light pass. */
+#define UMBRA_REBUILD_LIGHT_PASS                                                               \
+    (UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |                     \
+     UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING)
 
 typedef struct umbra_technique_info {
     umbra_shadow_technique id;
@@ -110,11 +114,11 @@ UMBRA_API const umbra_param_info *umbra_technique_param_get(const umbra_techniqu
 UMBRA_API const umbra_param_info *umbra_technique_param_find(const umbra_technique_info *t,
                                                              const char *name);
 
-/* Sets parameter `param` (name, key or alias) of technique `technique` in desc to value, after checking
- * it: a whole number for UINT (and within 32 bits), 0 or 1 for BOOL, and within the range or
- * allowed set (or 0 with UMBRA_PARAM_ZERO). technique NULL means every technique that has the
- * parameter, desc->technique first: each is checked before any is set, and a failure names the
- * first technique that refused. On failure nothing is changed and the status is
+/* Sets parameter `param` (name, key or alias) of technique `technique` in desc to value, after
+ * checking it: a whole number for UINT (and within 32 bits), 0 or 1 for BOOL, and within the
+ * range or allowed set (or 0 with UMBRA_PARAM_ZERO). technique NULL means every technique that
+ * has the parameter, desc->technique first: each is checked before any is set, and a failure
+ * names the first technique that refused. On failure nothing is changed and the status is
  * UMBRA_ERROR_INVALID_ARGUMENT (unknown technique or parameter, NULL desc or param, a value out
  * of range) with a message naming the technique, the parameter and the value, e.g.
  * "umbra_shadow_desc_set_param: cssm ray_block 4 must be 0 (the map's own) or lie in [1, 3]",
@@ -124,9 +128,9 @@ UMBRA_API umbra_status umbra_shadow_desc_set_param(umbra_shadow_desc *desc, cons
                                                    const char *param, double value,
                                                    char *message, size_t message_size);
 
-/* The value of parameter `param` (name, key or alias) of technique `technique` in desc, into *value;
- * technique NULL: desc->technique's if it has the parameter, else the first technique's that
- * has it. UMBRA_ERROR_INVALID_ARGUMENT for NULL arguments or an unknown technique or parameter. */
+/* The value of parameter `param` (name, key or alias) of technique `technique` in desc, into
+ * *value; technique NULL: desc->technique's if it has the parameter, else the first technique's
+ * that has it. UMBRA_ERROR_INVALID_ARGUMENT for NULL arguments or an unknown technique or parameter. */
 UMBRA_API umbra_status umbra_shadow_desc_get_param(const umbra_shadow_desc *desc,
                                                    const char *technique, const char *param,
                                                    double *value);

@@ -119,8 +119,10 @@ void shadow_params(nb::class_<umbra_shadow_desc> &so)
             std::string owners;
             for (uint32_t u = 0; u < umbra_technique_count(); ++u)
                 if (umbra_technique_param_find(umbra_technique_get(u), p->key))
-                    owners += std::string(owners.empty() ? "" : ", ") + umbra_technique_get(u)->name;
-            std::string doc = owners + ": " + p->doc + (p->unit ? std::string(", in ") + p->unit : "");
+                    owners += std::string(owners.empty() ? "" : ", ") +
+                              umbra_technique_get(u)->name;
+            std::string doc =
+                owners + ": " + p->doc + (p->unit ? std::string(", in ") + p->unit : "");
             const umbra_param_type type = p->type;
             std::string py_type = type == UMBRA_PARAM_FLOAT  ? "float"
                                   : type == UMBRA_PARAM_UINT ? "int"

@@ -54,7 +54,8 @@ export PKG_CONFIG_PATH=$libdir/pkgconfig
 cc -std=c11 -Wall -Wextra -Werror -o "$work/pc_c" "$work/consumer/consumer.c" \
    $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir" 2>"$work/pc_c.log" ||
   { cat "$work/pc_c.log" >&2; fail "consumer.c does not build through pkg-config"; }
-[ ! -s "$work/pc_c.log" ] || { cat "$work/pc_c.log" >&2; fail "including umbra.h printed the above"; }
+[ ! -s "$work/pc_c.log" ] ||
+  { cat "$work/pc_c.log" >&2; fail "including umbra.h printed the above"; }
 "$work/pc_c"
 c++ -std=c++17 -Wall -Wextra -Werror -DCL_TARGET_OPENCL_VERSION=300 -o "$work/pc_cxx" \
     "$work/consumer/consumer.cpp" $(pkg-config --cflags --libs umbra-io) -Wl,-rpath,"$libdir"
