@@ -20,6 +20,8 @@ static const bench_command commands[] = {
      "light-space map builds at equal map size: threshold, CSSM, deep; grey and coloured"},
     {"readme", bench_readme,
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
+    {"conformance", bench_conformance,
+     "every technique's errors in the conformance suite's cases beside the bounds it asserts"},
     {"scale", bench_scale,
      "time to first frame, frame times and memory against volume size (128^3 .. 1024^3 and up)"},
 };

@@ -59,7 +59,6 @@ void umbra__frame_update_light(umbra_renderer r)
                    umbra_transfer_function_is_grey(umbra__light_tf(r)))
                       ? 1u
                       : 3u;
-    r->shadow_params.channels = r->channels;
 }
 
 void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
@@ -151,6 +150,21 @@ umbra_status umbra__upload_params(umbra_renderer r)
     r->shadow_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    sizeof r->shadow_params, &r->shadow_params, &err);
     UMBRA_CL_CHECK(err, "clCreateBuffer(shadow constants)");
+fail:
+    return st;
+}
+
+umbra_status umbra__upload_constants(umbra_renderer r, const void *data, size_t bytes,
+                                     cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    cl_int err;
+    /* A new buffer for the same reason as umbra__upload_params. */
+    umbra__release_mem(buf);
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
+                          (void *)data, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(technique constants)");
 fail:
     return st;
 }

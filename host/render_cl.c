@@ -127,7 +127,7 @@ umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t
     if (!async.gated)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique '%s' enqueued its frame without the wait list's barrier",
-                           fn, umbra_shadow_technique_name(r->tech->id));
+                           fn, r->tech->info.name);
     /* On the in-order queue, a marker completes once every command before it has. */
     UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, done));
     UMBRA_CL(clFlush(ctx->queue));

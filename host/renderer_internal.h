@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/renderer_internal.h: the renderer's state and the shadow-technique interface.
  *
- * A shadow technique is a table of functions (umbra__technique) plus, for per-sample techniques,
- * a kernels/shadow_<name>.cl file compiled into the ray caster's program (the kernel side of the
- * interface is described in kernels/techniques/none.cl). To add a technique: write both, add its
- * table to the list in host/renderer.c, and its name to umbra_shadow_technique. */
+ * A shadow technique is a descriptor (umbra__technique): its public description (name, doc,
+ * flags, parameters with their defaults, ranges and docs, which the registry shows through
+ * umbra/registry.h), the kernel files compiled into the ray caster for its per-sample lookup
+ * (the kernel side of the interface is described in kernels/techniques/none.cl), and its host
+ * functions. Each technique defines umbra__technique_<name> in host/techniques/<name>.c; the
+ * registry (host/registry.c) lists them from umbra/techniques/list.h. docs/architecture.md says
+ * how to add one. */
 #ifndef UMBRA_RENDERER_INTERNAL_H
 #define UMBRA_RENDERER_INTERNAL_H
 
@@ -14,43 +17,99 @@
 #include "common/umbra_shared.h"
 
 _Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
-_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 3 * 4 + 8 * 4 + 13 * 4, "UmbraShadow layout");
+_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 4 * 4, "UmbraShadow layout");
+
+/* A parameter: what umbra/registry.h shows, and where its value lives in umbra_shadow_desc. */
+typedef struct umbra__param {
+    umbra_param_info info;
+    size_t offset;
+} umbra__param;
+
+/* The most parameters a technique may have (the rebuild key holds them; the registry's tests
+ * check every technique against it). */
+#define UMBRA__MAX_PARAMS 24
+
+/* umbra__param's type from the C field's: float, uint32_t or int (a flag). */
+#define UMBRA__PARAM_TYPE(field)                                                               \
+    _Generic((field), float: UMBRA_PARAM_FLOAT, uint32_t: UMBRA_PARAM_UINT, int: UMBRA_PARAM_BOOL)
+
+/* A parameter row of technique member `tech` (its field `field`), the rest of its
+ * umbra_param_info given as designated initializers: .doc, .default_value, .min, .max, ... The
+ * type comes from the field, the name and key are the field's; UMBRA__PARAM_KEYED gives another
+ * key (the flat name, unique among the technique's parameters). */
+#define UMBRA__PARAM_KEYED(tech, field, key_, ...)                                             \
+    {{.name = #field, .key = key_,                                                             \
+      .type = UMBRA__PARAM_TYPE(((umbra_shadow_desc *)0)->tech.field), __VA_ARGS__},           \
+     offsetof(umbra_shadow_desc, tech.field)}
+#define UMBRA__PARAM(tech, field, ...) UMBRA__PARAM_KEYED(tech, field, #field, __VA_ARGS__)
+
+/* A setting of a technique that `umbra-bench accuracy` sweeps (bench/accuracy.c). params is
+ * "key=value;..." (the technique's keys, "auto" for a zero_name, and umbra_render_desc's
+ * preintegrated), which the bench sets by name and writes as the setting's CSV field and image
+ * name: a setting keeps its name across runs, so recorded results stay comparable. */
+typedef struct umbra__setting {
+    const char *params;
+    const char *label; /* for people: "1024², 13 taps" */
+    uint32_t flags;    /* UMBRA__SWEEP_* */
+} umbra__setting;
+
+#define UMBRA__SWEEP_QUICK 1u          /* in the quick sweep (--quick) */
+#define UMBRA__SWEEP_FULL 2u           /* in the full sweep */
+#define UMBRA__SWEEP_PAPERS_CSSM 4u    /* full sweep, scenes marked `papers cssm` only */
+#define UMBRA__SWEEP_PAPERS_DEEP 8u    /* full sweep, scenes marked `papers deep` only */
+#define UMBRA__SWEEP_HEADLINE 16u      /* the technique's row(s) of the full sweep's headline */
+#define UMBRA__SWEEP_HEADLINE_QUICK 32u /* ... and of the quick sweep's */
+#define UMBRA__SWEEP_BUILDS 64u        /* a variant of `umbra-bench builds` (bench/builds.c),
+                                          named by its label: grey, and for a technique that is
+                                          not grey-only also coloured ("-grey", "-colored") */
 
 typedef struct umbra__technique {
-    umbra_shadow_technique id;
-    /* kernels/shadow_<name>.cl, compiled into the ray caster; NULL for a technique that renders
-     * the frame itself (render != NULL). */
-    const char *kernel_file;
-    /* Step, in voxels, of the light pass: the light transfer function is corrected for it. */
+    umbra_technique_info info;      /* first: umbra_technique_get returns &info */
+    const umbra__param *params;     /* info.param_count of them */
+    const umbra__setting *sweep;    /* the bench's settings, sweep_count of them */
+    uint32_t sweep_count;
+    /* The technique's kernel files (paths under kernels/, "techniques/cssm_shared.h",
+     * "techniques/cssm.cl"), NULL-terminated, compiled after kernels/common/ and before
+     * kernels/raycast.cl into the ray caster; NULL for a technique that renders the frame itself
+     * (render != NULL). */
+    const char *const *kernel_files;
+    /* Step, in voxels, of the light pass: the light transfer function is corrected for it;
+     * NULL with UMBRA_TECHNIQUE_NO_LIGHT. */
     float (*light_step)(const umbra_shadow_desc *desc);
-    /* Rejects parameters this technique cannot use (optional). */
+    /* What its light rays are called in messages ("shadow" for the reference's); NULL: "light". */
+    const char *ray_name;
+    /* Checks that the parameter table cannot express (optional); the table's ranges are checked
+     * before. */
     umbra_status (*validate)(umbra_renderer r, const umbra_shadow_desc *desc);
     /* (Re)builds the shadow structure for the renderer's current light inputs; adds device time
-     * to *ms. Called only when the light, volume, light transfer function or shadow description
-     * changed since the last build (optional). */
+     * to *ms. Called only when an input in info.rebuilt_by or a parameter flagged
+     * UMBRA_PARAM_REBUILDS changed since the last build (optional). */
     umbra_status (*build)(umbra_renderer r, double *ms);
-    /* Sets the technique's extra kernel arguments, starting at index first (optional). */
+    /* Sets the technique's extra kernel arguments (SHADOW_KERNEL_PARAMS), starting at index first
+     * (optional). Called for every render and query: what it reads of r->shadow that is not
+     * flagged UMBRA_PARAM_REBUILDS it must pass here, not at build. */
     umbra_status (*bind)(umbra_renderer r, cl_kernel k, cl_uint first);
     /* Renders the whole frame into out instead of the ray caster (optional). */
     umbra_status (*render)(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out,
                            double *ms);
-    /* Light channels the technique simulates whatever the transmission: 1 for a technique that
-     * can only carry grey light (the threshold map's binary depth test); 0 means the renderer's
-     * r->channels (3 in coloured mode, 1 when the light is grey). */
-    uint32_t channels;
     /* Device bytes held by the shadow structure (optional: 0). */
     size_t (*memory)(umbra_renderer r);
     /* Frees r->tech_state (optional). */
     void (*destroy)(umbra_renderer r);
+    /* What shared machinery needs of the technique (optional): a single-layer map's
+     * umbra__map_kind (host/techniques/maps.h). */
+    const void *data;
 } umbra__technique;
 
-/* What a shadow structure depends on; a change of any field means a rebuild. */
+/* What a shadow structure depends on; a change of any field means a rebuild. The fields of
+ * inputs the technique's info.rebuilt_by leaves out stay zero, and params holds the values of
+ * its parameters flagged UMBRA_PARAM_REBUILDS, in table order. */
 typedef struct umbra__light_key {
     uint64_t volume_id, light_tf_id;
     umbra_light light;
-    umbra_shadow_desc shadow;
-    umbra_transmission transmission;
-    int skip_empty;
+    int transmission, skip_empty;
+    int technique;
+    double params[UMBRA__MAX_PARAMS];
 } umbra__light_key;
 
 /* An asynchronous frame (umbra_renderer_render_to_cl_buffer_async), set on the renderer for the
@@ -241,7 +300,37 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size);
  * free index through *next. */
 umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next);
 
-extern const umbra__technique umbra__technique_none;
-extern const umbra__technique umbra__technique_reference;
+/* ---- the registry (host/registry.c) ------------------------------------------------------- */
+
+/* The descriptor with that id, or NULL. */
+const umbra__technique *umbra__technique_by_id(umbra_shadow_technique id);
+
+/* The technique's own kernel files (t->kernel_files) inserted into a program's file list: the
+ * common files first, then the technique's, then `last` (may be NULL); returns the count, at most
+ * max (the caller's array). */
+size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,
+                            const char *last, const char **files, size_t max);
+
+/* Refuses, naming fn, a desc whose parameters of technique t (and the shared map's, for a map)
+ * lie outside their ranges; then t's own validate. */
+umbra_status umbra__validate_shadow(umbra_renderer r, const umbra__technique *t,
+                                    const umbra_shadow_desc *d, const char *fn);
+
+/* Fills key with what technique t's structure depends on (info.rebuilt_by and its parameters
+ * flagged UMBRA_PARAM_REBUILDS). */
+void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t, umbra__light_key *key);
+
+/* Converts a desc of an older layout (struct_size tells which) into *out, or refuses it naming
+ * fn; *preintegrated is set to the 0.4 layout's preintegrated (-1 for a newer layout, which has
+ * none). host/shadow_desc_compat.c. */
+umbra_status umbra__shadow_desc_upgrade(umbra_renderer r, const umbra_shadow_desc *d,
+                                        umbra_shadow_desc *out, int *preintegrated,
+                                        const char *fn);
+
+/* Replaces *buf with a new read-only buffer holding bytes of data (a technique's kernel
+ * constants): nothing waits on the queue, and commands already enqueued keep the buffer they
+ * were enqueued with. */
+umbra_status umbra__upload_constants(umbra_renderer r, const void *data, size_t bytes,
+                                     cl_mem *buf);
 
 #endif

@@ -135,14 +135,14 @@ static umbra_renderer case_renderer(umbra_context ctx, const tech_case *tc, umbr
     o.shading = 1;
     o.jitter = 1;
     o.transmission = UMBRA_TRANSMISSION_COLORED;
+    o.preintegrated = tc->preintegrated;
     umbra_renderer r = test_renderer(ctx, sc->volume, sc->tf, &sc->camera, &light, &o);
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = tc->technique;
-    s.preintegrated = tc->preintegrated;
-    s.subsamples = tc->subsamples;
-    s.map_size = 128;
-    s.reference_step = 0.5f;
+    s.convolution.subsamples = tc->subsamples;
+    s.map.size = 128;
+    s.reference.step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     return r;
 }

@@ -59,7 +59,7 @@ static umbra_renderer scene(umbra_context ctx, umbra_shadow_technique technique,
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = technique;
-    s.map_size = 64;
+    s.map.size = 64;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     return r;
 }
@@ -195,8 +195,8 @@ static void test_deep_map_beyond_device_memory_fails_with_out_of_memory(void **s
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = UMBRA_SHADOW_DEEP;
-    s.map_size = 64;
-    s.epsilon = 0.0f;
+    s.map.size = 64;
+    s.deep.epsilon = 0.0f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, got), UMBRA_SUCCESS);
     umbra__deep_info info;

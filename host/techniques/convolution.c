@@ -83,24 +83,7 @@ static void rect_add(const UmbraFrame *F, const float p[3], float near, float lo
 
 static float conv_light_step(const umbra_shadow_desc *d)
 {
-    return d->slice_distance / (float)(d->subsamples + 1u);
-}
-
-static umbra_status conv_validate(umbra_renderer r, const umbra_shadow_desc *d)
-{
-    const char *fn = "umbra_renderer_set_shadow";
-    if (!(d->slice_distance >= 0.02f && d->slice_distance <= 16.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: slice_distance %g voxels must lie in [0.02, 16]", fn,
-                           d->slice_distance);
-    if (d->subsamples > 64)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: subsamples %u must be at most 64", fn, d->subsamples);
-    if (!(d->cone_angle_degrees >= 0.0f && d->cone_angle_degrees <= 60.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: cone_angle_degrees %g must lie in [0, 60]", fn,
-                           d->cone_angle_degrees);
-    return UMBRA_SUCCESS;
+    return d->convolution.slice_distance / (float)(d->convolution.subsamples + 1u);
 }
 
 /* Slice placement and the light check, from r->frame (camera part filled for this frame). */
@@ -158,10 +141,10 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
      * where a texel shrinks to nothing. */
     const float near = (F->flags & UMBRA_FLAG_ORTHO) ? 0.0f : 1e-3f * diag;
     G->z0 = fmaxf(zmin, near);
-    G->dz = r->shadow.slice_distance * umbra__voxel_world(r);
-    G->cone_tan = tanf(r->shadow.cone_angle_degrees * deg);
-    G->subsamples = r->shadow.subsamples;
-    G->pi_size = r->shadow.preintegrated ? UMBRA__PREINT_SIZE : 0u;
+    G->dz = r->shadow.convolution.slice_distance * umbra__voxel_world(r);
+    G->cone_tan = tanf(r->shadow.convolution.cone_angle_degrees * deg);
+    G->subsamples = r->shadow.convolution.subsamples;
+    G->pi_size = r->opts.preintegrated ? UMBRA__PREINT_SIZE : 0u;
     G->slices = 0;
     if (!(zmax > G->z0))
         return UMBRA_SUCCESS;
@@ -197,7 +180,8 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
     if (n > CONV_MAX_SLICES)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: slice_distance %g voxels needs %.0f slices over a depth of %g "
-                           "voxels; at most %u are allowed", fn, r->shadow.slice_distance, n,
+                           "voxels; at most %u are allowed", fn,
+                           r->shadow.convolution.slice_distance, n,
                            (z_end - G->z0) / umbra__voxel_world(r), CONV_MAX_SLICES);
     G->slices = (uint32_t)n;
     G->rect[0] = 0;
@@ -454,11 +438,56 @@ static umbra_status conv_render(umbra_renderer r, uint32_t w, uint32_t h, cl_mem
     return conv_run(r, w, h, out, UINT32_MAX, ms, NULL);
 }
 
+static const umbra__param params[] = {
+    UMBRA__PARAM(convolution, slice_distance, .doc = "distance between slices", .unit = "voxels",
+                 .default_value = 0.5, .min = 0.02, .max = 16),
+    UMBRA__PARAM(convolution, subsamples,
+                 .doc = "SCS: volume samples between two slices; the light is interpolated "
+                        "between the two",
+                 .default_value = 0, .min = 0, .max = 64),
+    UMBRA__PARAM(convolution, cone_angle_degrees, .alias = "cone_angle",
+                 .doc = "half-angle of the cone the kernel spreads the light over per slice "
+                        "(0: no blur)",
+                 .unit = "degrees", .default_value = 5, .min = 0, .max = 60),
+};
+
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"slice_distance=0.5;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 0.5",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 1",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"slice_distance=2;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 2",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=1;preintegrated=0;cone_angle=5", "SCS slice 2, 1 sub-sample",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=0;cone_angle=5", "SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 1",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 2",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=1;cone_angle=5",
+     "pre-int. SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+};
+
 const umbra__technique umbra__technique_convolution = {
-    .id = UMBRA_SHADOW_CONVOLUTION,
-    .kernel_file = NULL,
+    .info = {
+        .id = UMBRA_SHADOW_CONVOLUTION,
+        .name = "convolution",
+        .title = "slice-based convolution shadows (ICS / SCS)",
+        .doc = "Renders the frame itself in view-aligned slices front to back, carrying the "
+               "light from slice to slice through a blur kernel: soft shadows at the cost of a "
+               "kernel launch per slice every frame, for lights on the viewer's side only.",
+        .flags = UMBRA_TECHNIQUE_FRAME,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
+        .param_count = sizeof params / sizeof params[0],
+    },
+    .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .light_step = conv_light_step,
-    .validate = conv_validate,
     .render = conv_render,
     .memory = conv_memory,
     .destroy = conv_destroy,

@@ -65,8 +65,13 @@
 #ifndef UMBRA_CONTEXT_H
 #define UMBRA_CONTEXT_H
 
-/* umbra defines no CL_TARGET_OPENCL_VERSION for the application: it uses OpenCL 1.2 calls only,
- * and any newer target the application chooses compiles against these declarations. */
+/* umbra uses OpenCL 1.2 calls only, and any target the application chooses with
+ * CL_TARGET_OPENCL_VERSION compiles against these declarations. An application that chose none
+ * gets the OpenCL headers' own default, 3.0 (300), as CL/cl_version.h would set it, only without
+ * the note cl_version.h prints into every file that includes this header. */
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 300
+#endif
 #include <CL/cl.h>
 #include <stddef.h>
 

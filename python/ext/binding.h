@@ -136,6 +136,14 @@ template <class T> void apply_kwargs(T &d, const nb::kwargs &kw, const char *wha
     }
 }
 
+/* A ShadowOptions' keyword arguments: the technique first (a key means the current technique's
+ * parameter where it has one), then the parameters. `preintegrated`, a ShadowOptions field until
+ * umbra 0.4 and a RenderOptions one since, goes to *preintegrated (-1 when not given) where the
+ * caller takes it (Renderer.set_shadow, render), else is refused with a TypeError saying where it
+ * went (options.cpp). */
+void apply_shadow_kwargs(umbra_shadow_desc &d, const nb::kwargs &kw, const char *what,
+                         int *preintegrated = nullptr);
+
 /* ---- the object wrappers ------------------------------------------------------------------------ */
 
 struct Context {

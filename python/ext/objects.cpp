@@ -35,6 +35,22 @@ void renderer_set_options(Renderer &r, const umbra_render_desc &d)
     r.options = d;
 }
 
+/* set_shadow(**params) and render(**params): a ShadowOptions from the C defaults and params;
+ * `preintegrated`, a render option since umbra 0.5, is kept as a keyword and sets the options. */
+void renderer_set_shadow_kwargs(Renderer &r, const nb::kwargs &kw, const char *what)
+{
+    umbra_shadow_desc d;
+    umbra_shadow_desc_init(&d);
+    int preintegrated;
+    apply_shadow_kwargs(d, kw, what, &preintegrated);
+    if (preintegrated >= 0) {
+        umbra_render_desc o = r.options;
+        o.preintegrated = preintegrated;
+        renderer_set_options(r, o);
+    }
+    renderer_set_shadow(r, d);
+}
+
 void renderer_set_volume(Renderer &r, nb::handle v)
 {
     Volume &vol = nb::cast<Volume &>(v);
@@ -411,10 +427,7 @@ void bind_objects(nb::module_ &m)
         .def(
             "set_shadow",
             [](Renderer &r, const nb::kwargs &kw) {
-                umbra_shadow_desc d;
-                umbra_shadow_desc_init(&d);
-                apply_kwargs(d, kw, "umbra.Renderer.set_shadow");
-                renderer_set_shadow(r, d);
+                renderer_set_shadow_kwargs(r, kw, "umbra.Renderer.set_shadow");
             },
             nb::sig("def set_shadow(self, **params: typing.Any) -> None"), set_shadow_doc.c_str())
         .def(
@@ -435,12 +448,8 @@ void bind_objects(nb::module_ &m)
             "render",
             [](Renderer &r, uint32_t width, uint32_t height, nb::handle out, const nb::kwargs &kw) {
                 umbra_renderer h = r.get();
-                if (kw.size()) {
-                    umbra_shadow_desc d;
-                    umbra_shadow_desc_init(&d);
-                    apply_kwargs(d, kw, "umbra.Renderer.render");
-                    renderer_set_shadow(r, d);
-                }
+                if (kw.size())
+                    renderer_set_shadow_kwargs(r, kw, "umbra.Renderer.render");
                 nb::object result;
                 float *dst = nullptr;
                 if (out.is_none()) {

@@ -30,7 +30,7 @@ for f in libumbra.so libumbra.a libumbra_io.so libumbra_io.a cmake/umbra/umbraCo
 done
 soname=$(objdump -p "$libdir/libumbra.so" | awk '/SONAME/ {print $2}')
 case "$soname" in libumbra.so.[0-9]*) ;; *) fail "libumbra.so has no versioned soname ($soname)";; esac
-for f in umbra.h io.h config.h context.h; do
+for f in umbra.h io.h config.h context.h registry.h techniques/list.h techniques/cssm.h; do
   [ -f "$prefix/include/umbra/$f" ] || fail "header not installed: include/umbra/$f"
 done
 [ -x "$prefix/bin/umbra-render" ] || fail "umbra-render not installed"
@@ -58,8 +58,13 @@ cmake --build "$work/fp" -j"$jobs" >/dev/null
 
 echo "== pkg-config"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
+# Without CL_TARGET_OPENCL_VERSION, as most applications include it: nothing printed, no note
+# from CL/cl_version.h either.
 cc -std=c11 -Wall -Wextra -Werror -o "$work/pc_c" "$work/consumer/consumer.c" \
-   $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir"
+   $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir" 2>"$work/pc_c.log" ||
+  { cat "$work/pc_c.log" >&2; fail "consumer.c does not build through pkg-config"; }
+[ ! -s "$work/pc_c.log" ] ||
+  { cat "$work/pc_c.log" >&2; fail "including umbra.h printed the above"; }
 "$work/pc_c"
 c++ -std=c++17 -Wall -Wextra -Werror -DCL_TARGET_OPENCL_VERSION=300 -o "$work/pc_cxx" \
     "$work/consumer/consumer.cpp" $(pkg-config --cflags --libs umbra-io) -Wl,-rpath,"$libdir"
