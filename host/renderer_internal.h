@@ -120,8 +120,9 @@ struct umbra_renderer_t {
 };
 
 /* Samples per band of a banded launch (umbra__run_2d, umbra__band_plan), by the caller's
- * estimate of the samples a work-item marches; bands hold a work-group per compute unit, and on
- * a GPU at least UMBRA__BAND_MIN_ITEMS work-items, so that the device stays busy. */
+ * estimate of the samples a work-item marches; bands hold four work-groups per compute unit on
+ * a CPU, one per unit and at least UMBRA__BAND_MIN_ITEMS work-items on a GPU, so that the
+ * device stays busy. */
 #define UMBRA__BAND_SAMPLES 16777216.0
 #define UMBRA__BAND_MIN_ITEMS 16384.0
 
@@ -153,13 +154,13 @@ umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2]
  * rounded-up range without a progress callback): whole rows of work-groups of about
  * UMBRA__BAND_SAMPLES samples (or r->band_samples) at cost samples per work-item, or, where one
  * row of work-groups holds more, one row of them and as many columns as the budget allows; at
- * least a work-group per compute unit except under the knob. */
+ * least the work-groups host/progress.c's band_groups asks for, except under the knob. */
 void umbra__band_plan(umbra_renderer r, const size_t global[2], const size_t local[2],
                       double cost, size_t tile[2]);
 
 /* With a progress callback on a CPU device (or under the knob), halves the work-group local
- * (x or y, the longer first) while a band of a work-group per compute unit would hold more than
- * a band's samples at cost samples per work-item: a reference render at a fine shadow step
+ * (x or y, the longer first) while a band of the fewest work-groups (band_groups) would hold
+ * more than a band's samples at cost samples per work-item: a reference render at a fine shadow step
  * marches millions of samples per pixel. For kernels that index by global id only and use no
  * local memory (the ray caster): the image does not change. */
 void umbra__band_local(umbra_renderer r, double cost, size_t local[2]);
