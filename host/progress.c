@@ -90,7 +90,7 @@ void umbra__band_local(umbra_renderer r, double cost, size_t local[2])
 {
     if (!r->progress)
         return;
-    int knob, cpu;
+    int knob, cpu = 1;
     const double budget = band_budget(r, &knob);
     const double groups = knob ? 1.0 : band_groups(r->ctx, &cpu);
     if (!knob && !cpu)
@@ -113,7 +113,7 @@ void umbra__band_plan(umbra_renderer r, const size_t global[2], const size_t loc
     tile[1] = gy;
     if (!r->progress)
         return;
-    int knob, cpu;
+    int knob, cpu = 1;
     const double budget = band_budget(r, &knob);
     double items = budget / fmax(cost, 1.0);
     if (!knob) {

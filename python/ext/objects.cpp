@@ -516,9 +516,10 @@ void bind_objects(nb::module_ &m)
             "device work, with the fraction done: in [0, 1], non-decreasing, exactly 1 in the "
             "last call of a call that succeeds. A true return value cancels: the call raises "
             "umbra.Error with status ERROR_CANCELLED and the renderer stays usable. An exception "
-            "raised by f cancels the same way and propagates. Ctrl-C cancels every render "
-            "(with or without f) at the next piece and raises KeyboardInterrupt. f must not use "
-            "this renderer. None: no callable.")
+            "raised by f, or by truth-testing its result, cancels the same way and propagates. "
+            "Ctrl-C cancels every render (with or without f) at the next piece and raises "
+            "KeyboardInterrupt. Neither f nor another thread may use this renderer while the "
+            "call runs (RuntimeError). None: no callable.")
         .def_prop_ro(
             "stats",
             [](const Renderer &r) {
