@@ -112,6 +112,16 @@ static void release_kernels(umbra_renderer r)
     r->program = NULL; /* owned by the context's cache */
 }
 
+/* The last asynchronous frame's kernels, kept for its stats until the next frame. */
+static void drop_async_events(umbra_renderer r)
+{
+    if (r->async_first)
+        clReleaseEvent(r->async_first);
+    if (r->async_last)
+        clReleaseEvent(r->async_last);
+    r->async_first = r->async_last = NULL;
+}
+
 static void drop_technique(umbra_renderer r)
 {
     if (r->tech && r->tech->destroy)
@@ -120,12 +130,43 @@ static void drop_technique(umbra_renderer r)
     r->built_valid = 0;
 }
 
+umbra_status umbra__renderer_busy(umbra_renderer r, const char *fn)
+{
+    if (pthread_equal(r->busy_thread, pthread_self()))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: renderer %p is in the middle of %s on this thread: a progress "
+                           "callback must not call the renderer it reports on", fn, (void *)r,
+                           r->busy_fn);
+    return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                       "%s: renderer %p is in the middle of %s on another thread: a renderer is "
+                       "used by one thread at a time", fn, (void *)r, r->busy_fn);
+}
+
+umbra_status umbra__call_begin(umbra_renderer r, const char *fn)
+{
+    umbra_status st = umbra__check_process(r->ctx, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    r->busy_fn = fn;
+    r->busy_thread = pthread_self();
+    atomic_store(&r->busy, 1);
+    atomic_fetch_add(&r->refs, 1);
+    return UMBRA_SUCCESS;
+}
+
+void umbra__call_end(umbra_renderer r)
+{
+    atomic_store(&r->busy, 0);
+    umbra_renderer_release(r);
+}
+
 void umbra_renderer_release(umbra_renderer r)
 {
-    if (!r || atomic_fetch_sub(&r->refs, 1) > 1)
+    if (!r || atomic_fetch_sub(&r->refs, 1) > 1 || umbra__forked(r->ctx))
         return;
     drop_technique(r);
     release_kernels(r);
+    drop_async_events(r);
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
@@ -379,6 +420,16 @@ double umbra__ray_samples(umbra_renderer r, float step_voxels)
     return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
 }
 
+double umbra__march_cost(umbra_renderer r, int view)
+{
+    /* The reference marches a shadow ray of up to the diagonal over its step from every view
+     * sample or query point; a map's lookup costs about as much as a sample. */
+    double shadow = 0.0;
+    if ((r->tech->info.flags & UMBRA_TECHNIQUE_SHADOW_RAYS) && r->tech->light_step)
+        shadow = umbra__ray_samples(r, r->tech->light_step(&r->shadow));
+    return view ? umbra__ray_samples(r, r->opts.step) * (1.0 + shadow) : 1.0 + shadow;
+}
+
 static umbra_status check_ray_samples(umbra_renderer r, float step_voxels, const char *what,
                                       const char *fn)
 {
@@ -497,6 +548,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_begin(r);
+    drop_async_events(r);
     /* The convolution technique's slices set its view sampling (bounded with its light step). */
     if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
         return st;
@@ -554,17 +606,26 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         goto fail;
     /* A fill copies its pattern at the call: nothing points into this stack frame later. */
     UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0, sizeof zero,
-                                 0, NULL, NULL));
+                                 0, NULL, &ev));
+    st = umbra__async_hold(r, ev, 0);
+    clReleaseEvent(ev);
+    ev = NULL;
+    if (st != UMBRA_SUCCESS)
+        goto fail;
     if (r->async) {
         /* An asynchronous frame is one launch, not waited for: no bands, no progress. */
-        st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev);
         r->stats.render_ms = 0.0;
         r->stats.samples = 0;
-        goto fail; /* done or failed: the caller marks the frame's end */
+        if ((st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev)) ==
+            UMBRA_SUCCESS)
+            st = umbra__async_hold(r, ev, 1);
+        goto fail; /* done or failed: the caller hands out the frame's last kernel */
     }
     double ms = 0.0;
-    st = umbra__run_2d(r, r->render_kernel, global, r->render_local,
-                       umbra__ray_samples(r, r->opts.step), &ms, fn);
+    size_t local[2] = {r->render_local[0], r->render_local[1]};
+    const double cost = umbra__march_cost(r, 1);
+    umbra__band_local(r, cost, local);
+    st = umbra__run_2d(r, r->render_kernel, global, local, cost, &ms, fn);
     if (st != UMBRA_SUCCESS)
         goto fail;
     r->stats.render_ms = ms;
@@ -587,10 +648,9 @@ umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height
     return UMBRA_SUCCESS;
 }
 
-umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
+static umbra_status render_host(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
 {
     const char *fn = "umbra_renderer_render";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     if (!rgba)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
@@ -613,11 +673,20 @@ fail:
     return st;
 }
 
-umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
-                                         float *rgb)
+umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_host(r, width, height, rgba);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
+static umbra_status query_shadow(umbra_renderer r, const float *points, size_t count, float *rgb)
 {
     const char *fn = "umbra_renderer_query_shadow";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     cl_mem in = NULL, outb = NULL;
@@ -634,8 +703,9 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
                            "%s: technique '%s' has no per-point shadow lookup", fn,
                            r->tech->info.name);
     umbra__progress_begin(r);
-    if ((st = prepare_shadow(r, 1.0)) != UMBRA_SUCCESS)
+    if ((st = prepare_shadow(r, 0.5)) != UMBRA_SUCCESS)
         return st;
+    umbra__progress_phase(r, r->progress_last, 1.0);
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
         return st;
     /* The points are in the volume's world; the kernel takes them in its local frame. */
@@ -664,8 +734,13 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_uint), &n));
     if (r->tech->bind && (st = r->tech->bind(r, r->query_kernel, next)) != UMBRA_SUCCESS)
         goto fail;
-    size_t global = count;
-    if ((st = umbra__enqueue(ctx, r->query_kernel, 1, &global, NULL, NULL)) != UMBRA_SUCCESS)
+    /* In bands like a render: a shadow query of the reference marches a shadow ray per point. */
+    const size_t global[2] = {count, 1};
+    size_t group[2] = {64, 1};
+    const double cost = umbra__march_cost(r, 0);
+    double ms = 0.0;
+    umbra__band_local(r, cost, group);
+    if ((st = umbra__run_2d(r, r->query_kernel, global, group, cost, &ms, fn)) != UMBRA_SUCCESS)
         goto fail;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
     umbra__progress_end(r);
@@ -676,6 +751,18 @@ fail:
     return st;
 }
 
+umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
+                                         float *rgb)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = query_shadow(r, points, count, rgb);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
 umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
 {
     CHECK_R();
@@ -683,6 +770,22 @@ umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_get_stats: out is NULL");
     *out = r->stats;
+    /* An asynchronous frame's device time, from its first kernel's start to its last kernel's
+     * end, once that has completed. */
+    cl_int status = CL_QUEUED;
+    cl_ulong a = 0, b = 0;
+    if (r->async_last && r->ctx->profiling &&
+        clGetEventInfo(r->async_last, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status,
+                       NULL) == CL_SUCCESS &&
+        status == CL_COMPLETE &&
+        clGetEventProfilingInfo(r->async_first, CL_PROFILING_COMMAND_START, sizeof a, &a, NULL) ==
+            CL_SUCCESS &&
+        clGetEventProfilingInfo(r->async_last, CL_PROFILING_COMMAND_END, sizeof b, &b, NULL) ==
+            CL_SUCCESS &&
+        b >= a) {
+        out->render_ms = (double)(b - a) * 1e-6;
+        out->render_timing = UMBRA_TIMING_DEVICE;
+    }
     out->shadow_build_timing = r->stats.shadow_rebuilt ? measured_timing(r) : UMBRA_TIMING_NONE;
     const uint32_t flags = r->tech->info.flags;
     out->light_channels = (flags & UMBRA_TECHNIQUE_NO_LIGHT) ? 0

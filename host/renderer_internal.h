@@ -118,6 +118,8 @@ typedef struct umbra__async {
     cl_uint num_wait;
     const cl_event *wait_list;
     int gated;                               /* the wait list's barrier is enqueued */
+    cl_event first, last;                    /* the frame's first and last kernels (retained by
+                                                umbra__async_hold), or NULL */
 } umbra__async;
 
 struct umbra_renderer_t {
@@ -161,17 +163,26 @@ struct umbra_renderer_t {
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
+    cl_event async_first, async_last;        /* the last asynchronous frame's first and last
+                                                kernels (retained) until the next frame: its
+                                                device time for umbra_renderer_get_stats */
     umbra_progress_callback progress;        /* optional: umbra_renderer_set_progress */
     void *progress_user;
     double progress_lo, progress_hi;         /* the current phase's share of the call */
     double progress_last;                    /* last fraction reported (kept non-decreasing) */
     double band_samples;                     /* test knob: samples per band, 0: the default */
+    /* The render or query call in progress (umbra__call_begin): its name and thread. Any call
+     * on the renderer meanwhile, from its progress callback or another thread, is refused. */
+    atomic_int busy;
+    const char *busy_fn;
+    pthread_t busy_thread;
 };
 
-/* Samples per band of a banded launch (umbra__run_2d): about 0.1-1 s of PoCL on two cores, a
- * small fraction of a second on a GPU; bands hold at least UMBRA__BAND_MIN_ITEMS work-items so
- * a GPU stays busy. */
-#define UMBRA__BAND_SAMPLES 33554432.0
+/* Samples per band of a banded launch (umbra__run_2d, umbra__band_plan), by the caller's
+ * estimate of the samples a work-item marches; bands hold four work-groups per compute unit on
+ * a CPU, one per unit and at least UMBRA__BAND_MIN_ITEMS work-items on a GPU, so that the
+ * device stays busy. */
+#define UMBRA__BAND_SAMPLES 16777216.0
 #define UMBRA__BAND_MIN_ITEMS 16384.0
 
 /* An upper bound on the samples one ray with the given step (in voxels) takes in the volume's
@@ -191,11 +202,32 @@ umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn);
 
 /* Runs a 2D kernel over global[0] x global[1] work-items (rounded up to local, NULL: 8 x 8) and
  * waits, adding its device time to *ms. With a progress callback the range is split into bands
- * of rows, each one launch with a global offset, of about UMBRA__BAND_SAMPLES samples at
- * cost samples per work-item, one band in flight while the previous one is waited for and
- * reported; the callback can cancel between bands. The kernel must index by global id. */
+ * (umbra__band_plan), each one launch with a global offset, one band in flight while the
+ * previous one is waited for and reported; the callback can cancel between bands. cost is an
+ * upper bound on the samples one work-item marches (shadow and light rays included). The
+ * kernel must index by global id. */
 umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2],
                            const size_t *local, double cost, double *ms, const char *fn);
+
+/* The band umbra__run_2d launches at a time, in work-items along x and y (tile; the whole
+ * rounded-up range without a progress callback): whole rows of work-groups of about
+ * UMBRA__BAND_SAMPLES samples (or r->band_samples) at cost samples per work-item, or, where one
+ * row of work-groups holds more, one row of them and as many columns as the budget allows; at
+ * least the work-groups host/progress.c's band_groups asks for, except under the knob. */
+void umbra__band_plan(umbra_renderer r, const size_t global[2], const size_t local[2],
+                      double cost, size_t tile[2]);
+
+/* With a progress callback on a CPU device (or under the knob), halves the work-group local
+ * (x or y, the longer first) while a band of the fewest work-groups (band_groups) would hold
+ * more than a band's samples at cost samples per work-item: a reference render at a fine shadow step
+ * marches millions of samples per pixel. For kernels that index by global id only and use no
+ * local memory (the ray caster): the image does not change. */
+void umbra__band_local(umbra_renderer r, double cost, size_t local[2]);
+
+/* An upper bound on the samples one ray cast by the renderer's kernel marches per pixel or
+ * point: the view samples, each with its shadow ray for the reference technique (view 0: a
+ * shadow query, the shadow ray alone). */
+double umbra__march_cost(umbra_renderer r, int view);
 
 /* The view transfer function in effect, over the volume's normalised range (valid once a render
  * or query has begun). */
@@ -225,10 +257,25 @@ umbra_status umbra__light_tables(umbra_renderer r);
 
 /* ---- shared between host/renderer.c, tables.c, frame.c and render_cl.c ---------------------- */
 
-/* Every public renderer call starts with this: a NULL renderer has no context to record on. */
+/* Every public renderer call starts with this: a NULL renderer has no context to record on; a
+ * renderer in the middle of a render or query (called from its progress callback, or from
+ * another thread) is refused. */
 #define CHECK_R(fn)                                                                            \
     if (!r)                                                                                    \
-        return UMBRA_ERROR_INVALID_ARGUMENT;
+        return UMBRA_ERROR_INVALID_ARGUMENT;                                                   \
+    if (atomic_load(&r->busy))                                                                 \
+        return umbra__renderer_busy(r, __func__);
+
+/* UMBRA_ERROR_INVALID_ARGUMENT for fn called on r while r->busy_fn runs, naming both and the
+ * rule broken. */
+umbra_status umbra__renderer_busy(umbra_renderer r, const char *fn);
+
+/* Starts a render or query call named fn (after CHECK_R): refuses a forked child
+ * (umbra__check_process), marks r busy and holds a reference, so that the progress callback
+ * releasing r cannot free it under the call. umbra__call_end undoes both; r may be gone after
+ * it. */
+umbra_status umbra__call_begin(umbra_renderer r, const char *fn);
+void umbra__call_end(umbra_renderer r);
 
 /* Small vector helpers (lengths in double, so 1e20 does not overflow a float square). */
 static inline double umbra__len3d(const float v[3])
@@ -285,6 +332,15 @@ umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height
  * that waits on the host (builds, blocking reads) and before the first command that writes the
  * output. Enqueues a barrier on the wait list; the in-order queue holds everything after it. */
 umbra_status umbra__frame_gate(umbra_renderer r);
+
+/* Every command an asynchronous frame enqueues after its gate passes its event here (a no-op
+ * for blocking frames; the caller keeps its own reference). PoCL 3.1 aborts the process
+ * (pocl_update_event_failed) when the failure of a wait-list event reaches a command whose
+ * event nobody holds, as happens to commands enqueued without an event: each is held until it
+ * completes (a callback then releases it). PoCL calls no callback for an event that ends in an
+ * error, so the events of a failed frame are kept, a few hundred bytes. kernel: the command is
+ * one of the frame's kernels (the first starts the frame's device time, the last is *done). */
+umbra_status umbra__async_hold(umbra_renderer r, cl_event e, int kernel);
 
 /* Copies r->frame and r->shadow_params into fresh device buffers (r->frame_buf, r->shadow_buf):
  * nothing waits on the queue, and commands already enqueued keep the constants they were

@@ -318,7 +318,7 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     }
     cl_uint next = 0;
     /* Declared before the first UMBRA_CL: the fail path releases them. */
-    cl_event pending = NULL, mark = NULL;
+    cl_event pending = NULL, mark = NULL, sliced = NULL;
     if ((st = umbra__bind_common(r, s->slice, &next)) != UMBRA_SUCCESS)
         return st;
     const cl_uint base = next;
@@ -349,10 +349,10 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     double t0 = umbra__now_ms();
     /* With a progress callback the slices go in groups of about UMBRA__BAND_SAMPLES samples:
      * after queueing a group the previous one is waited for and reported, so the device stays
-     * busy and a cancel waits for at most two groups. */
+     * busy and a cancel waits for at most two groups. An asynchronous frame waits for nothing. */
     const double per_slice = (double)range[0] * range[1] * (G.subsamples + 1u);
     uint32_t group = UINT32_MAX;
-    if (r->progress) {
+    if (r->progress && !r->async) {
         double budget = r->band_samples > 0.0 ? r->band_samples : UMBRA__BAND_SAMPLES;
         double g = budget / (per_slice > 1.0 ? per_slice : 1.0);
         group = g < 1.0 ? 1u : g > (double)n ? (n ? n : 1u) : (uint32_t)g;
@@ -377,8 +377,14 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         UMBRA_CL(clSetKernelArg(s->slice, base + 4, sizeof(cl_mem), &s->l[(i + 1) % 2]));
         UMBRA_CL(clSetKernelArg(s->slice, base + 5, sizeof(cl_mem), &s->l[i % 2]));
         UMBRA_CL(clSetKernelArg(s->slice, base + 9, sizeof ctl, &ctl));
+        cl_event *slot = i == 0 ? &first : r->async ? &sliced : NULL;
         UMBRA_CL(clEnqueueNDRangeKernel(ctx->queue, s->slice, 2, offset, range, local, 0, NULL,
-                                        i == 0 ? &first : NULL));
+                                        slot));
+        if (slot && (st = umbra__async_hold(r, *slot, 1)) != UMBRA_SUCCESS)
+            goto fail;
+        if (sliced)
+            clReleaseEvent(sliced);
+        sliced = NULL;
     }
     if (last == UINT32_MAX) {
         uint32_t k = G.slices ? (G.slices - 1) % 2 : 0;
@@ -392,9 +398,10 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof geo, &geo));
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof ctl, &ctl));
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof rect, &rect));
-        if ((st = umbra__enqueue(ctx, s->resolve, 2, global, NULL, &end)))
+        if ((st = umbra__enqueue(ctx, s->resolve, 2, global, NULL, &end)) ||
+            (st = umbra__async_hold(r, end, 1)))
             goto fail;
-        if (r->async) { /* the caller marks the frame's end; nothing is timed */
+        if (r->async) { /* the caller hands out the resolve as the frame's end; nothing is timed */
             if (ms)
                 *ms = 0.0;
             ms = NULL;
@@ -426,6 +433,8 @@ fail:
         clReleaseEvent(pending);
     if (mark)
         clReleaseEvent(mark);
+    if (sliced)
+        clReleaseEvent(sliced);
     if (first)
         clReleaseEvent(first);
     if (end)

@@ -73,6 +73,9 @@ typedef struct umbra_param_info {
                                        (umbra_renderer_query_shadow gives UMBRA_ERROR_UNSUPPORTED),
                                        and no light from behind the viewer */
 #define UMBRA_TECHNIQUE_NO_LIGHT 8u /* takes no light pass at all (none) */
+#define UMBRA_TECHNIQUE_SHADOW_RAYS 16u /* marches a shadow ray from every view sample and query
+                                         point (reference): each costs up to the box diagonal
+                                         over its light step in samples */
 
 /* umbra_technique_info.rebuilt_by: the renderer's inputs whose change rebuilds the technique's
  * shadow structure (beside its parameters flagged UMBRA_PARAM_REBUILDS; a camera move never

@@ -247,9 +247,22 @@ UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint
  * light only once those can complete. When nothing needs building (e.g. only the camera moved)
  * the call waits for nothing. Per-frame constants are copied at the call; the renderer, volume,
  * transfer functions and rgba may be changed or released as soon as it returns (OpenCL keeps
- * what the enqueued commands use until they complete). The frame's stats have
+ * what the enqueued commands use until they complete).
+ *
+ * *done is the frame's last kernel (the ray caster's; the convolution technique's resolve): its
+ * profiling counters, when the queue has profiling, time that kernel, which for every technique
+ * but convolution is the frame's device work. Until *done has completed the stats have
  * render_timing UMBRA_TIMING_NONE, render_ms 0 and samples 0 (the call does not wait for them);
- * the device time is available from *done when the queue has profiling. */
+ * once it has, umbra_renderer_get_stats gives the frame's device time (first kernel's start to
+ * last kernel's end, UMBRA_TIMING_DEVICE) until the next frame. Samples stay 0.
+ *
+ * A wait-list event that ends in an error (clSetUserEventStatus with a negative status, a failed
+ * command) fails the frame: none of its commands run, rgba is left as it was, and *done ends with
+ * a negative status, as do later frames queued behind it on the same in-order queue. An event
+ * that has already failed at the call is refused (UMBRA_ERROR_INVALID_ARGUMENT): PoCL would never
+ * run the frame. umbra holds every command of the frame until it has ended: PoCL 3.1 aborts the
+ * process when such a failure reaches a command nobody holds, so commands the application queues
+ * behind a wait-list event or behind *done need events it holds until they end too. */
 UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
                                                                 uint32_t height, cl_mem rgba,
                                                                 cl_uint num_wait,
@@ -291,13 +304,20 @@ typedef struct umbra_render_stats {
 UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
 
 /* Progress and cancellation of long calls. Called on the calling thread during
- * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow,
- * between pieces of device work (bands of rows of the image or of the shadow map, groups of
- * convolution slices), with the fraction of the call's work done: in [0, 1], non-decreasing,
- * and exactly 1 in the last call of a call that succeeds. Return nonzero to cancel: the call
- * waits for the piece in flight (bands are sized to about 2^25 samples), then returns
- * UMBRA_ERROR_CANCELLED; the renderer stays usable (the next render rebuilds what was cut
- * short). The callback must not call this renderer. */
+ * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow
+ * (and the shadow build of an asynchronous frame), between pieces of device work (bands of the
+ * image, the query points or the shadow map, groups of convolution slices), with the fraction
+ * of the call's work done: in [0, 1], non-decreasing, and exactly 1 in the last call of a call
+ * that succeeds. Pieces are sized to about 2^24 samples of the work's upper bound, shadow and
+ * light rays included (a reference render marches a shadow ray from every view sample), but at
+ * least four work-groups per compute unit on a CPU (docs/performance.md: a reference render of
+ * 512^2 at steps 0.25 and 0.05 on 2 loaded cores reported at most 0.43 s apart and stopped
+ * within 0.27 s of a cancel; it had stopped 119 s after one). Return nonzero to cancel: the
+ * call waits for the piece in flight, then returns UMBRA_ERROR_CANCELLED; the renderer stays
+ * usable (the next render rebuilds what was cut short). The callback must not call this
+ * renderer: any call on it from the callback (or from another thread meanwhile) is refused with
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the call in progress; releasing it is allowed, the render
+ * finishes first. */
 typedef int (*umbra_progress_callback)(void *user, float fraction);
 
 /* Installs (or with NULL removes) the progress callback; user is passed to it (borrowed). With a

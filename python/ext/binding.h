@@ -207,9 +207,24 @@ struct Renderer {
      * error indicator to be raised when the C call returns. */
     nb::object progress = nb::none();
     bool python_error = false;
-    /* True during a C call that reports progress: the callable must not use this renderer (the C
-     * renderer is in the middle of the call), so get() and close() refuse. */
+    /* True during a C call that reports progress, made on thread busy_thread (Python's thread
+     * ident): neither the callable nor another thread (which runs while the callable runs Python
+     * code) may use this renderer then (the C renderer is in the middle of the call), so get()
+     * and close() refuse, saying which of the two it is. */
     bool busy = false;
+    unsigned long busy_thread = 0;
+    /* The refusal: RuntimeError naming what was attempted (what: "used", "closed"). */
+    [[noreturn]] void refuse_busy(const char *what) const
+    {
+        if (busy_thread == PyThread_get_thread_ident())
+            throw std::runtime_error(std::string("umbra.Renderer: ") + what +
+                                     " from its own progress callback, which must not call the "
+                                     "renderer it reports on");
+        throw std::runtime_error(std::string("umbra.Renderer: ") + what +
+                                 " while another thread renders with it (a renderer is used by "
+                                 "one thread at a time: give each thread its own, or hold a lock "
+                                 "around its calls)");
+    }
     Renderer() = default;
     Renderer(const Renderer &) = delete;
     ~Renderer() { close(); }
@@ -224,8 +239,7 @@ struct Renderer {
     umbra_renderer get() const
     {
         if (busy)
-            throw std::runtime_error("umbra.Renderer: used from its own progress callback, "
-                                     "which must not call the renderer it reports on");
+            refuse_busy("used");
         if (!h)
             raise_closed("Renderer");
         return h;

@@ -8,7 +8,8 @@
  * life: it runs the Python progress callable, if any, and checks for signals, so that Ctrl-C
  * cancels a long render between two bands of device work and surfaces as KeyboardInterrupt. The
  * GIL stays held during renders: the callback runs on the calling thread and may call Python
- * directly, and no other Python thread can reach the (single-threaded) C renderer meanwhile. */
+ * directly. Other Python threads run only while the callable runs Python code; one that reaches
+ * the renderer then is refused (Renderer::refuse_busy), as the callable itself is. */
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -103,7 +104,14 @@ int on_progress(void *user, float fraction)
     try {
         nb::object f = r.progress; /* the callable may replace itself */
         nb::object res = f(py_float(fraction));
-        return PyObject_IsTrue(res.ptr()) == 1 ? 1 : 0;
+        /* Truth-testing the result runs Python (__bool__, __len__) and may raise: that exception
+         * cancels like the callable's own. */
+        int cancel = PyObject_IsTrue(res.ptr());
+        if (cancel < 0) {
+            r.python_error = true;
+            return 1;
+        }
+        return cancel;
     } catch (nb::python_error &e) {
         e.restore();
         r.python_error = true;
@@ -143,7 +151,11 @@ PyType_Slot renderer_slots[] = {{Py_tp_traverse, (void *)renderer_traverse},
 /* Marks a renderer busy for the length of a C call that reports progress. */
 struct Busy {
     Renderer &r;
-    explicit Busy(Renderer &rr) : r(rr) { r.busy = true; }
+    explicit Busy(Renderer &rr) : r(rr)
+    {
+        r.busy = true;
+        r.busy_thread = PyThread_get_thread_ident();
+    }
     ~Busy() { r.busy = false; }
     Busy(const Busy &) = delete;
 };
@@ -151,8 +163,7 @@ struct Busy {
 void renderer_close(Renderer &r)
 {
     if (r.busy)
-        throw std::runtime_error("umbra.Renderer: closed from its own progress callback, "
-                                 "which must not call the renderer it reports on");
+        r.refuse_busy("closed");
     r.close();
 }
 
@@ -532,9 +543,10 @@ void bind_objects(nb::module_ &m)
             "device work, with the fraction done: in [0, 1], non-decreasing, exactly 1 in the "
             "last call of a call that succeeds. A true return value cancels: the call raises "
             "umbra.Error with status ERROR_CANCELLED and the renderer stays usable. An exception "
-            "raised by f cancels the same way and propagates. Ctrl-C cancels every render "
-            "(with or without f) at the next piece and raises KeyboardInterrupt. f must not use "
-            "this renderer. None: no callable.")
+            "raised by f, or by truth-testing its result, cancels the same way and propagates. "
+            "Ctrl-C cancels every render (with or without f) at the next piece and raises "
+            "KeyboardInterrupt. Neither f nor another thread may use this renderer while the "
+            "call runs (RuntimeError). None: no callable.")
         .def_prop_ro(
             "stats",
             [](const Renderer &r) {
