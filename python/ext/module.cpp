@@ -72,6 +72,9 @@ NB_MODULE(_umbra, m)
     m.attr("Error") = nb::steal(error_type);
 
     m.attr("MAP_SIZE_AUTO") = UMBRA_MAP_SIZE_AUTO;
+    /* Set by python/CMakeLists.txt from UMBRA_IO_IMAGES: the wheel is built without
+     * OpenImageIO. */
+    m.attr("has_image_io") = nb::bool_(UMBRA_PY_IMAGE_IO != 0);
 
     m.def(
         "version", []() { return std::string(umbra_version()); },
