@@ -27,6 +27,10 @@ typedef struct options {
     umbra_shadow_desc shadow; /* the technique and every parameter given (registry keys) */
     const char *data_roots[1024]; /* --allow-data-root, borrowed from argv */
     size_t data_root_count;
+    umbra_render_mode mode;       /* --mode */
+    umbra_clip_desc clip;         /* --clip-plane, --crop */
+    const char *channel_tf[UMBRA_MAX_CHANNELS - 1]; /* --channel-tf: channels 1.. */
+    uint32_t channel_tf_count;
 } options;
 
 /* Fills o from the command line. Returns 0, or prints what is wrong to stderr and returns 1 (bad
