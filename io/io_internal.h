@@ -77,6 +77,16 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out);
 
+/* io/paraview.c: nonzero if the ParaView preset file path holds a preset named name (nothing is
+ * recorded anywhere: a file that is not a preset file just holds none). */
+int umbra__paraview_file_holds(const char *path, const char *name);
+
+/* io/paraview_search.c: the first file of the preset search path (see there) holding a preset
+ * named name, in a malloc'ed *found. Else UMBRA_ERROR_IO naming the directories searched; with
+ * also_file the message says name was not a file either. */
+umbra_status umbra__paraview_find(umbra_context ctx, const char *func, const char *name,
+                                  int also_file, char **found);
+
 #ifdef __cplusplus
 }
 #endif

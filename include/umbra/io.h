@@ -104,32 +104,51 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
  * values ascending (equal values make a step): in [0,1] of the volume's normalised range, or with
  * a range, data values in [LO, HI]. The file must be a regular file; errors are UMBRA_ERROR_IO or
  * UMBRA_ERROR_FORMAT naming path:line and the value. A path ending in .json is read
- * as a ParaView preset with umbra_transfer_function_load_paraview's defaults. */
+ * as a ParaView preset with umbra_transfer_function_load_paraview's defaults; a bare name (no
+ * '/') that is no file is a preset's name, looked up in the preset search path (as
+ * umbra_transfer_function_load_paraview with no path), e.g. "Cool to Warm". */
 UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                                     umbra_transfer_function *out);
+
+/* The opacity a ParaView preset without "Points" gets (ParaView's own presets carry none): a
+ * linear ramp from 0 at the preset's lowest x to this at its highest, or this for every category
+ * of a categorical preset. An opacity is per voxel, as in umbra's own format. */
+#define UMBRA_PARAVIEW_DEFAULT_OPACITY 0.1
 
 /* Options for ParaView presets; umbra_paraview_options_init sets the defaults. */
 typedef struct umbra_paraview_options {
     size_t struct_size;      /* sizeof(umbra_paraview_options); set by
                                 umbra_paraview_options_init */
     const char *preset;      /* the "Name" to pick in a file of several; NULL (default): the
-                                first */
-    uint32_t resolution;     /* table entries, 2..65536 (default 1024) */
+                                first. With no path, the name looked up in the preset search
+                                path */
+    uint32_t resolution;     /* table entries, 2..65536 (default 1024); a categorical preset
+                                gets more where its categories need them (4 per unit of value) */
     int range_given;         /* 0 (default): the table spans the preset's own x range */
     double range_min, range_max; /* with range_given: the data values the table spans */
+    double default_opacity;  /* in [0,1]: the opacity of a preset without "Points" (default
+                                UMBRA_PARAVIEW_DEFAULT_OPACITY) */
 } umbra_paraview_options;
 
 /* Fills options with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_paraview_options_init(umbra_paraview_options *options);
 
 /* Reads a ParaView JSON colour-map preset (RGBPoints, Points with midpoint and sharpness,
- * ColorSpace RGB / Lab / CIELAB / Diverging / Step; see the README) and evaluates it into a table
- * of options->resolution entries over a data range: the preset's own (smallest to largest x of its
- * points) or options' range, and gives the table that data range
+ * ColorSpace RGB / HSV / Lab / CIELAB / Diverging / Step, HSVWrap; categorical IndexedColors with
+ * Annotations; see the README) and evaluates it into a table of options->resolution entries
+ * over a data range: the preset's own (smallest to largest x of its points; a categorical
+ * preset's values +-0.5) or options' range, and gives the table that data range
  * (umbra_transfer_function_set_range), so renderers place it over each volume's values in data
- * units (e.g. Hounsfield units). options may be NULL (defaults). range, if not NULL, receives
- * the data range the table spans. Malformed files are UMBRA_ERROR_FORMAT naming the key and
- * point; unsupported colour spaces UMBRA_ERROR_UNSUPPORTED. */
+ * units (e.g. Hounsfield units). A categorical preset is a step table: values within 0.5 of an
+ * annotated value take its colour, others are transparent. options may be NULL (defaults).
+ * path NULL: options->preset is looked up by name in the preset search path, in order: each
+ * directory of $UMBRA_PRESET_PATH (':'-separated), the presets installed with umbra
+ * (<prefix>/share/umbra/presets, found from the library's own location; <build>/share/umbra/
+ * presets in a build tree), the current directory; in each, the .json files in name order, the
+ * first holding that Name wins (else UMBRA_ERROR_IO naming the directories). range, if not NULL,
+ * receives the data range the table spans. Malformed files are UMBRA_ERROR_FORMAT naming the key
+ * and point; a file of more than 64 MiB or 2^20 JSON values is refused before it is parsed;
+ * the Lab/CIEDE2000 colour space is UMBRA_ERROR_UNSUPPORTED. */
 UMBRA_API umbra_status umbra_transfer_function_load_paraview(umbra_context ctx, const char *path,
                                                              const umbra_paraview_options *options,
                                                              umbra_transfer_function *out,
