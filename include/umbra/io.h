@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, MetaImage, Voreen .dat
- * and raw files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
- * EXR.
+/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, MetaImage, DICOM,
+ * TIFF stacks, Voreen .dat and raw files, transfer functions from text files and ParaView JSON
+ * presets, images to and from PNG and EXR.
  *
  * It is a library of its own (libumbra_io, CMake target umbra::io, pkg-config umbra-io) that links
- * Teem, OpenImageIO, nifticlib and cJSON, so that libumbra itself depends on OpenCL and the C
- * library only. It is built on libumbra's public API: whatever it loads an application could
- * also hand to umbra_volume_create or umbra_transfer_function_create itself. Errors are recorded
- * on the context like every umbra error. Readers open regular files only. */
+ * Teem, OpenImageIO, nifticlib, cJSON, GDCM, libtiff and expat, so that libumbra itself depends
+ * on OpenCL and the C library only. It is built on libumbra's public API: whatever it loads an
+ * application could also hand to umbra_volume_create or umbra_transfer_function_create itself.
+ * Errors are recorded on the context like every umbra error. Readers open regular files only. */
 #ifndef UMBRA_IO_H
 #define UMBRA_IO_H
 
@@ -23,7 +23,9 @@ extern "C" {
 /* ---- volumes --------------------------------------------------------------------------------- */
 
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .mha / .mhd
- * (MetaImage), .dat (Voreen). */
+ * (MetaImage), .dat (Voreen), .tif / .tiff (umbra_volume_load_tiff), .dcm / .dicom / .ima or any
+ * file starting with DICOM's preamble (umbra_volume_load_dicom); a directory is a TIFF stack when
+ * every file in it is named .tif / .tiff, else a DICOM series. */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
@@ -77,6 +79,37 @@ UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *pa
  * voxels, other types) is UMBRA_ERROR_UNSUPPORTED. */
 UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
                                                    umbra_volume *out);
+
+/* Loads a DICOM volume through GDCM: count files of one series in any order, one directory (its
+ * files, DICOMDIR and names starting with '.' passed over, subdirectories not entered), or one
+ * file (one slice, or a multi-frame image placed by GDCM's geometry). Greyscale, 8 or 16 bits
+ * allocated, any transfer syntax GDCM decodes. Slices are sorted by ImagePositionPatient along
+ * the slice normal and must be one series (SeriesInstanceUID), one size and pixel layout, one
+ * orientation, on one line along the normal (no gantry tilt) at uniform steps (each within 1% of a
+ * step of its place): the z spacing is that step, x and y PixelSpacing's column and row spacing.
+ * The volume carries DICOM's patient space (LPS, millimetres): origin the first slice's
+ * ImagePositionPatient, axes the row and column directions of ImageOrientationPatient and their
+ * normal. RescaleSlope/Intercept are applied per slice: without rescale the stored type is kept
+ * (int8 becomes int16); integer rescale gives int16 when the rescaled values fit (else float32);
+ * a fractional one float32. Anything else (a second series, another size, a missing or repeated
+ * position, uneven spacing, colour, truncated pixel data, compressed data claiming more than
+ * 1032 times its bytes) is UMBRA_ERROR_FORMAT or UMBRA_ERROR_UNSUPPORTED naming the file and
+ * value; at most 65536 files. */
+UMBRA_API umbra_status umbra_volume_load_dicom(umbra_context ctx, const char *const *paths,
+                                               size_t count, umbra_volume *out);
+
+/* Loads a TIFF stack through libtiff: one multi-page TIFF (each full-resolution page a z slice;
+ * pages marked reduced-resolution are passed over), count single-page TIFFs in the order given,
+ * or one directory (its .tif / .tiff files in natural name order: "2" before "10"). Greyscale
+ * pages, stripped or tiled, any compression libtiff decodes: 8- and 16-bit unsigned kept, int16
+ * kept, int8 becomes int16, 32-bit float kept; every slice the same size and type. OME-TIFF:
+ * PhysicalSizeX/Y/Z of its OME-XML (in the x axis's unit) are the spacing, and it must hold one
+ * image of one channel and time point; else the spacing is 1. The box is centred. A page that
+ * does not decode, slices of different sizes, colour or other sample types, more than 65536
+ * slices or slices claiming more than 1032 times their files' bytes are refused with
+ * UMBRA_ERROR_FORMAT or UMBRA_ERROR_UNSUPPORTED naming the file and page. */
+UMBRA_API umbra_status umbra_volume_load_tiff(umbra_context ctx, const char *const *paths,
+                                              size_t count, umbra_volume *out);
 
 typedef struct umbra_raw_desc {
     size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */
