@@ -301,7 +301,6 @@ umbra_status decode(dicom_load &L, const slice_header &h, std::vector<char> &buf
     gdcm::DataElement pixels(gdcm::Tag(0x7fe0, 0x0010));
     pixels.SetVR(gdcm::VR::OB);
     pixels.SetValue(*sq);
-    pixels.SetVLToUndefined();
     gdcm::Image img;
     img.SetNumberOfDimensions(2);
     img.SetDimension(0, h.cols);

@@ -85,7 +85,7 @@ umbra_status umbra__volume_load_tiff(umbra_context ctx, const char *func, const 
 umbra_status umbra__volume_load_dicom(umbra_context ctx, const char *func,
                                       const char *const *paths, size_t count, umbra_volume *out);
 
-/* io/series.c: a directory as a TIFF stack (every file named .tif / .tiff) or a DICOM series;
+/* io/series.c: a directory as a TIFF stack (when it holds .tif / .tiff files) or a DICOM series;
  * and whether a file name is a TIFF's. */
 umbra_status umbra__volume_load_directory(umbra_context ctx, const char *func, const char *dir,
                                           umbra_volume *out);

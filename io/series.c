@@ -4,8 +4,8 @@
  *
  * A directory is read one level deep: its regular files whose names do not start with '.', in
  * natural name order (strverscmp: "slice2" before "slice10"), at most SERIES_MAX_FILES of them;
- * subdirectories are not entered. For DICOM the file named DICOMDIR (a media index, no image) is
- * passed over; for TIFF only names ending in .tif / .tiff count. Every file a directory or list
+ * subdirectories are not entered. A directory holding .tif / .tiff files is a TIFF stack of just
+ * those; any other is a DICOM series of all its files but DICOMDIR (a media index, no image). Every file a directory or list
  * names is opened by umbra's one file opener (regular files only, never blocking). Neither
  * format lets one file name another that umbra would open: DICOMDIR's references are not
  * followed, and OME-TIFF's multi-file datasets (BinaryOnly, UUID FileName) are refused by the
@@ -57,7 +57,7 @@ static void free_list(char **paths, size_t count)
 }
 
 /* The files of dir that a series of kind takes, as full paths in natural name order. For
- * SERIES_ANY, *kind_out says which: TIFF when every file is named .tif / .tiff, else DICOM. */
+ * SERIES_ANY, *kind_out says which: TIFF when any file is named .tif / .tiff, else DICOM. */
 static umbra_status list_directory(umbra_context ctx, const char *func, const char *dir,
                                    series_kind kind, series_kind *kind_out, char ***out,
                                    size_t *count)
@@ -66,7 +66,7 @@ static umbra_status list_directory(umbra_context ctx, const char *func, const ch
     DIR *d = opendir(dir);
     struct dirent *e;
     char **names = NULL;
-    size_t n = 0, subdirs = 0, tiffs = 0, dir_len = strlen(dir);
+    size_t n = 0, subdirs = 0, tiffs = 0, kept, i, dir_len = strlen(dir);
     umbra_status st = UMBRA_SUCCESS;
 
     *out = NULL;
@@ -105,8 +105,7 @@ static umbra_status list_directory(umbra_context ctx, const char *func, const ch
             free(path);
             continue;
         }
-        if ((kind == SERIES_TIFF && !umbra__is_tiff_name(e->d_name)) ||
-            (kind != SERIES_TIFF && strcmp(e->d_name, "DICOMDIR") == 0)) {
+        if (kind == SERIES_TIFF && !umbra__is_tiff_name(e->d_name)) {
             free(path);
             continue;
         }
@@ -121,6 +120,20 @@ static umbra_status list_directory(umbra_context ctx, const char *func, const ch
         names[n++] = path;
     }
     closedir(d);
+    /* A directory holding TIFFs is a stack of them; otherwise a DICOM series, whose DICOMDIR
+     * (a media index) is passed over. */
+    if (kind == SERIES_ANY) {
+        kind = tiffs > 0 ? SERIES_TIFF : SERIES_DICOM;
+    }
+    for (i = 0, kept = 0; i < n; ++i) {
+        const char *base = strrchr(names[i], '/') + 1;
+        if (kind == SERIES_TIFF ? umbra__is_tiff_name(base) : strcmp(base, "DICOMDIR") != 0) {
+            names[kept++] = names[i];
+        } else {
+            free(names[i]);
+        }
+    }
+    n = kept;
     if (st == UMBRA_SUCCESS && n == 0) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                          "%s: \"%s\" holds no %sfiles%s (subdirectories are not searched%s)", func,
@@ -134,7 +147,7 @@ static umbra_status list_directory(umbra_context ctx, const char *func, const ch
     }
     qsort(names, n, sizeof *names, compare_versions);
     if (kind_out) {
-        *kind_out = kind == SERIES_ANY ? (tiffs == n ? SERIES_TIFF : SERIES_DICOM) : kind;
+        *kind_out = kind;
     }
     *out = names;
     *count = n;

@@ -106,6 +106,9 @@ typedef struct slice_spec {
     double slope, intercept, thickness;
     int no_position, no_rescale;
     int honest_length;        /* the pixel data element's length is pixel_bytes, not the claim */
+    const char *syntax;       /* NULL: explicit VR little endian, uncompressed */
+    const void *fragment;     /* with syntax: the one compressed fragment (else RLE of pixels) */
+    size_t fragment_bytes;
     const void *pixels;       /* rows x cols samples of bits_allocated */
     size_t pixel_bytes;       /* what the pixel data element holds (may be less: truncated) */
 } slice_spec;
@@ -129,6 +132,37 @@ static slice_spec default_spec(void)
     return s;
 }
 
+/* DICOM RLE Lossless (PS3.5 G): a 64-byte header of segment offsets, then one PackBits segment
+ * per byte plane, most significant first; literal runs of up to 128 bytes. */
+static void rle_encode(const slice_spec *s, bytes *out)
+{
+    size_t n = (size_t)s->rows * s->cols, planes = s->bits_allocated / 8u, p, i;
+    const unsigned char *px = s->pixels;
+    uint32_t header[16] = {0};
+    bytes seg = {0};
+    header[0] = (uint32_t)planes;
+    for (p = 0; p < planes; ++p) {
+        header[1 + p] = (uint32_t)(64 + seg.n);
+        for (i = 0; i < n; i += 128) {
+            size_t run = n - i < 128 ? n - i : 128, k;
+            unsigned char c = (unsigned char)(run - 1);
+            put(&seg, &c, 1);
+            for (k = 0; k < run; ++k) {
+                /* little-endian samples: plane p (MSB first) is byte planes-1-p */
+                put(&seg, px + (i + k) * planes + (planes - 1 - p), 1);
+            }
+        }
+        if (seg.n & 1) {
+            put(&seg, "\x80", 1); /* a no-op byte keeps segments even */
+        }
+    }
+    for (i = 0; i < 16; ++i) {
+        put_u32(out, header[i]);
+    }
+    put(out, seg.p, seg.n);
+    free(seg.p);
+}
+
 static void write_slice(const char *path, const slice_spec *s, int instance)
 {
     bytes meta = {0}, b = {0};
@@ -141,7 +175,7 @@ static void write_slice(const char *path, const slice_spec *s, int instance)
     element(&meta, 0x0002, 0x0001, "OB", version, 2);
     text(&meta, 0x0002, 0x0002, "UI", ct);
     text(&meta, 0x0002, 0x0003, "UI", sop);
-    text(&meta, 0x0002, 0x0010, "UI", "1.2.840.10008.1.2.1"); /* explicit VR little endian */
+    text(&meta, 0x0002, 0x0010, "UI", s->syntax ? s->syntax : "1.2.840.10008.1.2.1");
     text(&meta, 0x0002, 0x0012, "UI", "1.2.826.0.1.3680043.2.1125.1");
 
     put(&b, (unsigned char[128]){0}, 128);
@@ -186,7 +220,28 @@ static void write_slice(const char *path, const slice_spec *s, int instance)
         snprintf(buf, sizeof buf, "%.10g", s->slope);
         text(&b, 0x0028, 0x1053, "DS", buf);
     }
-    {
+    if (s->syntax) {
+        /* Encapsulated: an empty basic offset table, one fragment, the sequence delimiter. */
+        bytes frag = {0};
+        if (s->fragment) {
+            put(&frag, s->fragment, s->fragment_bytes);
+        } else {
+            rle_encode(s, &frag);
+        }
+        if (frag.n & 1) {
+            put(&frag, "\0", 1);
+        }
+        put_u16(&b, 0x7fe0);
+        put_u16(&b, 0x0010);
+        put(&b, "OB", 2);
+        put_u16(&b, 0);
+        put_u32(&b, 0xffffffffu);
+        put_u16(&b, 0xfffe), put_u16(&b, 0xe000), put_u32(&b, 0);
+        put_u16(&b, 0xfffe), put_u16(&b, 0xe000), put_u32(&b, (uint32_t)frag.n);
+        put(&b, frag.p, frag.n);
+        put_u16(&b, 0xfffe), put_u16(&b, 0xe0dd), put_u32(&b, 0);
+        free(frag.p);
+    } else {
         /* The element's length is what the header claims; the bytes may fall short. */
         size_t claim = (size_t)s->rows * s->cols * s->samples * (s->bits_allocated / 8u);
         put_u16(&b, 0x7fe0);
@@ -559,6 +614,68 @@ static void test_dicom_hostile_files_refused(void **state)
     assert_null(vol);
 }
 
+static void make_rle(slice_spec *s, int k)
+{
+    (void)k;
+    s->syntax = "1.2.840.10008.1.2.5";
+}
+
+static const unsigned char junk[40] = {0xff, 0xd8, 0xff, 0xc3, 0x00, 0x0b, 0x10, 0xff, 0xff,
+                                       0x7f, 0xff, 0x01, 0x11, 0x00, 0xff, 0xda, 0x00, 0x08,
+                                       0x01, 0x01, 0x00, 0x01, 0x00, 0x00, 0x12, 0x34};
+
+static void make_junk_jpeg(slice_spec *s, int k)
+{
+    (void)k;
+    s->syntax = "1.2.840.10008.1.2.4.70"; /* JPEG lossless, first order */
+    s->fragment = junk;
+    s->fragment_bytes = sizeof junk;
+}
+
+static void make_junk_rle(slice_spec *s, int k)
+{
+    (void)k;
+    s->syntax = "1.2.840.10008.1.2.5";
+    s->fragment = junk + 4;
+    s->fragment_bytes = 24;
+}
+
+static void make_junk_j2k(slice_spec *s, int k)
+{
+    (void)k;
+    s->syntax = "1.2.840.10008.1.2.4.90"; /* JPEG 2000 lossless */
+    s->fragment = junk;
+    s->fragment_bytes = sizeof junk;
+}
+
+/* RLE Lossless (GDCM's decoder) gives the same volume as the uncompressed series; junk in the
+ * place of a JPEG, RLE or JPEG 2000 fragment is refused with a message, not a crash. */
+static void test_dicom_compressed_series(void **state)
+{
+    umbra_context ctx = *state;
+    umbra_volume vol = NULL;
+    char dir[PATH_MAX_LEN];
+    size_t c;
+    static const struct {
+        const char *name;
+        void (*edit)(slice_spec *, int);
+    } junk_cases[] = {{"junk_jpeg", make_junk_jpeg}, {"junk_rle", make_junk_rle},
+                      {"junk_j2k", make_junk_j2k}};
+    tmp_path(dir, "rle");
+    write_series(dir, 1024.0, make_rle);
+    assert_int_equal(umbra_volume_load(ctx, dir, &vol), UMBRA_SUCCESS);
+    assert_series_volume(vol, UMBRA_INT16);
+    umbra_volume_release(vol);
+    for (c = 0; c < sizeof junk_cases / sizeof junk_cases[0]; ++c) {
+        print_message("case %s\n", junk_cases[c].name);
+        tmp_path(dir, junk_cases[c].name);
+        write_series(dir, 1024.0, junk_cases[c].edit);
+        test_assert_failed(ctx, umbra_volume_load(ctx, dir, &vol), UMBRA_ERROR_FORMAT,
+                           "cannot decode", NULL);
+        assert_null(vol);
+    }
+}
+
 /* umbra-render --volume DIR/ --tf "Cool to Warm" --technique cssm on the series: exit 0 and a
  * picture whose centre is the lit volume, not the background. */
 static void test_cli_renders_dicom_directory_with_named_preset(void **state)
@@ -597,6 +714,7 @@ int main(void)
         cmocka_unit_test(test_dicom_storage_type_is_chosen_honestly),
         cmocka_unit_test(test_dicom_hostile_series_refused),
         cmocka_unit_test(test_dicom_hostile_files_refused),
+        cmocka_unit_test(test_dicom_compressed_series),
         cmocka_unit_test(test_cli_renders_dicom_directory_with_named_preset),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);

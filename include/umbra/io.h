@@ -24,8 +24,8 @@ extern "C" {
 
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .mha / .mhd
  * (MetaImage), .dat (Voreen), .tif / .tiff (umbra_volume_load_tiff), .dcm / .dicom / .ima or any
- * file starting with DICOM's preamble (umbra_volume_load_dicom); a directory is a TIFF stack when
- * every file in it is named .tif / .tiff, else a DICOM series. */
+ * file starting with DICOM's preamble (umbra_volume_load_dicom); a directory is a TIFF stack of
+ * its .tif / .tiff files when it holds any, else a DICOM series. */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
