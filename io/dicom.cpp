@@ -353,10 +353,16 @@ bool convert(const dicom_load &L, const slice_header &h, const char *buf, size_t
 {
     for (size_t i = 0; i < n; ++i) {
         double v = stored_value(h, buf, i) * slope + intercept;
+        /* The type was chosen so that every value fits; clamped all the same, so that a file
+         * changed between the passes cannot make a conversion undefined. */
         switch (L.type) {
-        case UMBRA_UINT8: static_cast<uint8_t *>(dst)[i] = (uint8_t)v; break;
-        case UMBRA_UINT16: static_cast<uint16_t *>(dst)[i] = (uint16_t)v; break;
-        case UMBRA_INT16: static_cast<int16_t *>(dst)[i] = (int16_t)v; break;
+        case UMBRA_UINT8: static_cast<uint8_t *>(dst)[i] = (uint8_t)std::clamp(v, 0.0, 255.0); break;
+        case UMBRA_UINT16:
+            static_cast<uint16_t *>(dst)[i] = (uint16_t)std::clamp(v, 0.0, 65535.0);
+            break;
+        case UMBRA_INT16:
+            static_cast<int16_t *>(dst)[i] = (int16_t)std::clamp(v, -32768.0, 32767.0);
+            break;
         default: {
             float fv = (float)v;
             if (!std::isfinite(fv)) {

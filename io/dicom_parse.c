@@ -305,6 +305,28 @@ static umbra_status take_value(walker *w, const element *e, int explicit_vr)
 static umbra_status walk(walker *w, uint64_t pos, uint64_t end, int undefined, int explicit_vr,
                          int depth, uint64_t *after);
 
+/* read_element for the next element of a data set or sequence, counted against the limit. */
+static umbra_status next_element(walker *w, uint64_t pos, uint64_t end, int explicit_vr,
+                                 element *e)
+{
+    if (++w->elements > DICOM_MAX_ELEMENTS) {
+        return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": more than %lu elements",
+                           w->func, w->path, DICOM_MAX_ELEMENTS);
+    }
+    return read_element(w, pos, end, explicit_vr, e);
+}
+
+/* Marks the (one) top-level pixel data element found. */
+static umbra_status found_pixels(walker *w)
+{
+    if (w->out->has_pixels) {
+        return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": two pixel data elements",
+                           w->func, w->path);
+    }
+    w->out->has_pixels = 1;
+    return UMBRA_SUCCESS;
+}
+
 /* The items of a sequence whose value starts at pos: to end (defined length), or to its
  * delimiter (undefined: end is the container's end). */
 static umbra_status sequence(walker *w, uint64_t pos, uint64_t end, int undefined,
@@ -322,11 +344,7 @@ static umbra_status sequence(walker *w, uint64_t pos, uint64_t end, int undefine
             *after = pos;
             return UMBRA_SUCCESS;
         }
-        if (++w->elements > DICOM_MAX_ELEMENTS) {
-            return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": more than %lu elements",
-                               w->func, w->path, DICOM_MAX_ELEMENTS);
-        }
-        if ((st = read_element(w, pos, end, 0, &e)) != UMBRA_SUCCESS) {
+        if ((st = next_element(w, pos, end, 0, &e)) != UMBRA_SUCCESS) {
             return st;
         }
         if (e.group == 0xfffe && e.elem == 0xe0dd && undefined) {
@@ -417,11 +435,7 @@ static umbra_status walk(walker *w, uint64_t pos, uint64_t end, int undefined, i
             *after = pos;
             return UMBRA_SUCCESS;
         }
-        if (++w->elements > DICOM_MAX_ELEMENTS) {
-            return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": more than %lu elements",
-                               w->func, w->path, DICOM_MAX_ELEMENTS);
-        }
-        if ((st = read_element(w, pos, end, explicit_vr, &e)) != UMBRA_SUCCESS) {
+        if ((st = next_element(w, pos, end, explicit_vr, &e)) != UMBRA_SUCCESS) {
             return st;
         }
         if (e.group == 0xfffe) {
@@ -435,12 +449,10 @@ static umbra_status walk(walker *w, uint64_t pos, uint64_t end, int undefined, i
         }
         if (e.length == UNDEFINED) {
             if (depth == 0 && e.group == 0x7fe0 && e.elem == 0x0010) {
-                if (w->out->has_pixels) {
-                    return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT,
-                                       "%s: \"%s\": two pixel data elements", w->func, w->path);
+                w->out->pixels_fragmented = 1;
+                if ((st = found_pixels(w)) == UMBRA_SUCCESS) {
+                    st = fragments(w, e.value, &pos);
                 }
-                w->out->has_pixels = w->out->pixels_fragmented = 1;
-                st = fragments(w, e.value, &pos);
             } else if (explicit_vr && strcmp(e.vr, "SQ") != 0 && strcmp(e.vr, "UN") != 0) {
                 return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT,
                                    "%s: \"%s\": element (%04X,%04X) of VR %s at byte %llu has "
@@ -466,14 +478,9 @@ static umbra_status walk(walker *w, uint64_t pos, uint64_t end, int undefined, i
             uint64_t seq_end = 0;
             st = sequence(w, e.value, e.value + e.length, 0, 1, depth + 1, &seq_end);
         } else if (depth == 0 && e.group == 0x7fe0 && e.elem == 0x0010) {
-            if (w->out->has_pixels) {
-                return umbra__fail(w->ctx, UMBRA_ERROR_FORMAT,
-                                   "%s: \"%s\": two pixel data elements", w->func, w->path);
-            }
-            w->out->has_pixels = 1;
             w->out->pixel_offset = e.value;
             w->out->pixel_length = e.length;
-            st = UMBRA_SUCCESS;
+            st = found_pixels(w);
         } else {
             st = depth == 0 ? take_value(w, &e, explicit_vr) : UMBRA_SUCCESS;
         }

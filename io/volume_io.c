@@ -629,9 +629,6 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
     if (!path) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
     }
-    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
-        return umbra__volume_load_directory(ctx, __func__, path, out);
-    }
     ext = path_extension(path);
     if (equal_nocase(ext, strlen(ext), "nrrd") || equal_nocase(ext, strlen(ext), "nhdr")) {
         return umbra_volume_load_nrrd(ctx, path, out);
@@ -646,6 +643,10 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
     }
     if (equal_nocase(ext, strlen(ext), "mha") || equal_nocase(ext, strlen(ext), "mhd")) {
         return umbra_volume_load_metaimage(ctx, path, out);
+    }
+    /* After the single-file formats, which refuse a directory by name as not a regular file. */
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        return umbra__volume_load_directory(ctx, __func__, path, out);
     }
     if (umbra__is_tiff_name(path)) {
         return umbra_volume_load_tiff(ctx, &path, 1, out);

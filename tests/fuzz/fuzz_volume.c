@@ -4,7 +4,8 @@
  * data file "data.raw" holds what follows the first "@@" in the input, 2 a Voreen .dat over
  * "data.raw" the same way, 3 a headerless raw file with dims, type and header bytes taken from the
  * next four bytes, 4 a MetaImage .mha, 5 a MetaImage .mhd over "data.raw" as for 1 and 2 (its
- * ElementDataFile must say data.raw to reach it). Everything must end in a volume or a status with a message, never a crash,
+ * ElementDataFile must say data.raw to reach it), 6 a DICOM file (.dcm: umbra's structure walk,
+ * then GDCM's decoders), 7 a TIFF (.tif: libtiff, OME-XML through expat). Everything must end in a volume or a status with a message, never a crash,
  * leak or sanitizer report, and the context must stay usable (the next input uses it).
  *
  * Speed: the loaders refuse any size the file cannot hold, so with libFuzzer's -max_len 4096 raw
@@ -38,14 +39,15 @@ static double declared_voxels(const char *text)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char *const names[6] = {"input.nrrd", "input.nhdr", "input.dat", NULL,
-                                         "input.mha",  "input.mhd"};
+    static const char *const names[8] = {"input.nrrd", "input.nhdr", "input.dat",
+                                         NULL,         "input.mha",  "input.mhd",
+                                         "input.dcm",  "input.tif"};
     if (size < 1)
         return 0;
     umbra_context ctx = fuzz_context();
     umbra_volume vol = NULL;
     umbra_status st;
-    int mode = data[0] % 6;
+    int mode = data[0] % 8;
     ++data;
     --size;
     if (mode != 3) {
@@ -61,7 +63,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (skip)
             return 0;
         const uint8_t *split = NULL;
-        for (size_t i = 0; mode > 0 && mode != 4 && i + 1 < size; ++i)
+        for (size_t i = 0; mode > 0 && mode != 4 && mode < 6 && i + 1 < size; ++i)
             if (data[i] == '@' && data[i + 1] == '@') {
                 split = data + i;
                 break;
