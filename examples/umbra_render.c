@@ -30,6 +30,8 @@ static void usage(FILE *f)
         "  --scene-size N        built-in scene resolution N^3 (default per scene)\n"
         "  --volume FILE         volume file: .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI),\n"
         "                        .mha/.mhd (MetaImage), .dat (Voreen)\n"
+        "  --allow-data-root DIR a header's detached data file may also lie under DIR\n"
+        "                        (repeatable; by default only in the header's own directory)\n"
         "  --raw FILE --raw-dims XxYxZ --raw-type uint8|uint16|int16|float32 [--raw-big-endian]\n"
         "  --tf FILE             transfer function: text format (see README) or a ParaView\n"
         "                        preset .json (x in the volume's data units)\n"
@@ -262,6 +264,8 @@ typedef struct options {
     int progress;                                                   /* -1: when a terminal */
     uint32_t seed;
     umbra_shadow_desc shadow;
+    const char *data_roots[1024]; /* --allow-data-root, borrowed from argv */
+    size_t data_root_count;
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
@@ -294,6 +298,7 @@ static int parse_args(int argc, char **argv, options *o)
         } else if (FLAG("--scene")) { NEED(); o->scene = v; }
         else if (FLAG("--scene-size")) { NEED(); if (!parse_uint(v, &o->scene_size)) BAD("--scene-size '%s' is not a whole number", v); }
         else if (FLAG("--volume")) { NEED(); o->volume = v; }
+        else if (FLAG("--allow-data-root")) { NEED(); if (o->data_root_count == 1024) BAD("at most 1024 --allow-data-root"); o->data_roots[o->data_root_count++] = v; }
         else if (FLAG("--raw")) { NEED(); o->raw = v; }
         else if (FLAG("--raw-dims")) {
             NEED();
@@ -449,7 +454,11 @@ static int run(const options *o, session *s)
     umbra_camera cam;
     umbra_light light;
     if (o->volume || o->raw) {
-        st = o->volume ? umbra_volume_load(s->ctx, o->volume, &s->volume)
+        umbra_volume_load_options lo;
+        umbra_volume_load_options_init(&lo);
+        lo.data_roots = o->data_roots;
+        lo.data_root_count = o->data_root_count;
+        st = o->volume ? umbra_volume_load_with_options(s->ctx, o->volume, &lo, &s->volume)
                        : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
         if (st != UMBRA_SUCCESS)
             return exit_status(st);

@@ -51,6 +51,9 @@ extern PyObject *error_type;
 void check(umbra_context ctx, umbra_status st);
 /* ValueError, as for a closed file. */
 [[noreturn]] void raise_closed(const char *what);
+/* path as a C string, or ValueError naming what ("umbra.Context.load_volume: path") when it holds
+ * a NUL character, at which C would cut it ("a.png\x00.txt" would write a.png). */
+const char *path_arg(const std::string &path, const char *what);
 
 /* ---- arrays (support.cpp) ---------------------------------------------------------------------- */
 

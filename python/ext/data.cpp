@@ -122,7 +122,8 @@ TransferFunction load_paraview(Context &ctx, const std::string &path,
         o.range_max = range->second;
     }
     umbra_transfer_function t = nullptr;
-    check(c, umbra_transfer_function_load_paraview(c, path.c_str(), &o, &t, nullptr));
+    check(c, umbra_transfer_function_load_paraview(
+                 c, path_arg(path, "umbra.TransferFunction.load_paraview: path"), &o, &t, nullptr));
     return TransferFunction(c, t);
 }
 

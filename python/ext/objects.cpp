@@ -176,7 +176,8 @@ void bind_objects(nb::module_ &m)
                 d.platform_index = platform_index;
                 d.device_index = device_index;
                 d.sampler = enum_from<umbra_sampler_kind>(sampler);
-                d.cache_dir = cache_dir ? cache_dir->c_str() : nullptr;
+                d.cache_dir =
+                    cache_dir ? path_arg(*cache_dir, "umbra.Context: cache_dir") : nullptr;
                 d.use_environment = use_environment;
                 std::string message;
                 d.error_callback = [](void *user, umbra_status, const char *msg) {
@@ -213,24 +214,38 @@ void bind_objects(nb::module_ &m)
             "The sampler back end in use (never AUTO).")
         .def(
             "load_volume",
-            [](Context &c, const std::string &path) {
+            [](Context &c, const std::string &path,
+               std::optional<std::vector<std::string>> data_roots) {
+                const char *p = path_arg(path, "umbra.Context.load_volume: path");
+                std::vector<const char *> roots; /* into data_roots, alive for the call */
+                if (data_roots)
+                    for (const std::string &r : *data_roots)
+                        roots.push_back(path_arg(r, "umbra.Context.load_volume: data_roots entry"));
+                umbra_volume_load_options o;
+                umbra_volume_load_options_init(&o);
+                o.data_roots = roots.empty() ? nullptr : roots.data();
+                o.data_root_count = roots.size();
                 umbra_volume v = nullptr;
-                check(c.get(), umbra_volume_load(c.get(), path.c_str(), &v));
+                check(c.get(), umbra_volume_load_with_options(c.get(), p, &o, &v));
                 return Volume(c.h, v);
             },
-            "path"_a,
+            "path"_a, nb::kw_only(), "data_roots"_a = nb::none(),
             "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib), .mha/.mhd "
             "(MetaImage), .dat (Voreen), .tif/.tiff (TIFF stacks, OME-TIFF), .dcm (DICOM), or a "
             "directory (a DICOM series, or a TIFF stack when it holds .tif files) through "
             "umbra_io, with the file's spacing and world transform (NRRD space directions, "
-            "NIfTI sform/qform, MetaImage Offset and TransformMatrix, DICOM patient space).")
+            "NIfTI sform/qform, MetaImage Offset and TransformMatrix, DICOM patient space). A "
+            "detached data file (NRRD 'data file', MetaImage ElementDataFile, Voreen "
+            "ObjectFileName) must lie in the header's own directory (after symbolic links and "
+            "'..'), else umbra.Error ERROR_IO naming it; data_roots, a list of directories, "
+            "allows those too ('/' allows any file).")
         .def(
             "load_volume",
             [](Context &c, const std::vector<std::string> &paths) {
                 std::vector<const char *> p;
                 bool tiff = !paths.empty();
                 for (const std::string &s : paths) {
-                    p.push_back(s.c_str());
+                    p.push_back(path_arg(s, "umbra.Context.load_volume: paths entry"));
                     size_t dot = s.rfind('.');
                     std::string ext = dot == std::string::npos ? "" : s.substr(dot);
                     tiff &= ext == ".tif" || ext == ".tiff" || ext == ".TIF" || ext == ".TIFF";
@@ -248,7 +263,8 @@ void bind_objects(nb::module_ &m)
             "load_transfer_function",
             [](Context &c, const std::string &path) {
                 umbra_transfer_function t = nullptr;
-                check(c.get(), umbra_transfer_function_load(c.get(), path.c_str(), &t));
+                const char *p = path_arg(path, "umbra.Context.load_transfer_function: path");
+                check(c.get(), umbra_transfer_function_load(c.get(), p, &t));
                 return TransferFunction(c.h, t);
             },
             "path"_a,
@@ -271,7 +287,8 @@ void bind_objects(nb::module_ &m)
                                   "pass numpy.ascontiguousarray(rgba)");
                 if (a.shape(0) > UINT32_MAX || a.shape(1) > UINT32_MAX)
                     raise_invalid("umbra.Context.write_image: image too large");
-                check(c.get(), umbra_image_write(c.get(), path.c_str(), (uint32_t)a.shape(1),
+                const char *p = path_arg(path, "umbra.Context.write_image: path");
+                check(c.get(), umbra_image_write(c.get(), p, (uint32_t)a.shape(1),
                                                  (uint32_t)a.shape(0), (const float *)a.data()));
             },
             "path"_a, "rgba"_a,
@@ -282,7 +299,9 @@ void bind_objects(nb::module_ &m)
             [](Context &c, const std::string &path) {
                 uint32_t w = 0, h = 0;
                 float *p = nullptr;
-                check(c.get(), umbra_image_read(c.get(), path.c_str(), &w, &h, &p));
+                check(c.get(), umbra_image_read(c.get(),
+                                                path_arg(path, "umbra.Context.read_image: path"),
+                                                &w, &h, &p));
                 nb::capsule owner(p, [](void *q) noexcept { std::free(q); });
                 return float_out(p, {h, w, 4}, owner);
             },

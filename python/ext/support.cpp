@@ -59,6 +59,19 @@ void check(umbra_context ctx, umbra_status st)
     throw nb::value_error((std::string("umbra.") + what + " is closed").c_str());
 }
 
+const char *path_arg(const std::string &path, const char *what)
+{
+    size_t at = path.find('\0');
+    if (at != std::string::npos) {
+        std::string shown = nb::cast<std::string>(nb::repr(nb::str(path.data(), path.size())));
+        throw nb::value_error((std::string(what) + " " + shown + " contains a NUL character (at " +
+                               std::to_string(at) + "); a file name cannot, and it is refused "
+                               "rather than cut there")
+                                  .c_str());
+    }
+    return path.c_str();
+}
+
 /* ---- arrays ----------------------------------------------------------------------------------- */
 
 std::string dtype_name(nb::dlpack::dtype t)

@@ -11,6 +11,7 @@ shape (z, y, x) and copied once, to the device; ``Renderer.render`` returns a ne
         scene = umbra.Scene(ctx, "spheres")
         with scene.renderer() as r:
             img = r.render(256, 256, technique="cssm", taps=7)
+        umbra.Image(img)   # in a notebook, a cell ending in this shows the picture
 
 Every failure raises :class:`umbra.Error`, whose ``status`` is an :class:`umbra.Status` and whose
 ``message`` is umbra's, naming the function and the value. Context, Volume, TransferFunction and
@@ -52,12 +53,18 @@ except ImportError as e:  # pragma: no cover - depends on how Python was started
         "outside python/."
     ) from e
 
+from ._display import Image, install_reprs, show, to_srgb8
+
+install_reprs(VolumeInfo, RenderStats)
+del install_reprs
+
 __version__: str = version()
 
 __all__ = [
     "Camera",
     "Context",
     "Error",
+    "Image",
     "Light",
     "LightType",
     "MAP_SIZE_AUTO",
@@ -75,6 +82,8 @@ __all__ = [
     "Volume",
     "VolumeInfo",
     "scene_names",
+    "show",
     "technique_names",
+    "to_srgb8",
     "version",
 ]

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tests/consumer/check.sh SOURCE_DIR BUILD_DIR: umbra as an application takes it in.
-#  1. `cmake --install` into a fresh prefix; nothing installed names the source or build tree; the
-#     installed umbra-render finds an installed preset by name.
+#  1. `cmake --install` into a fresh prefix; no installed file, binaries included, names the source
+#     or build tree; the installed umbra-render finds an installed preset by name.
 #  2. The consumers (a copy of this folder, outside the source tree) build and run against the
 #     prefix alone through find_package(umbra), then through pkg-config (umbra, umbra-io, and the
 #     static libraries with --static), then with umbra as an add_subdirectory of theirs.
@@ -42,9 +42,17 @@ done
 (cd "$work" && env -u UMBRA_PRESET_PATH "$prefix/bin/umbra-render" --tf "Cool to Warm" \
    --technique none --size 16x16 --out "$work/preset.png" 2>/dev/null) ||
   fail "the installed umbra-render does not find the preset \"Cool to Warm\" by name"
-if grep -rIl -e "$src" -e "$build" "$prefix/include" "$libdir/cmake" "$libdir/pkgconfig"; then
-  fail "the files above name the source or build tree"
+# Every installed file, binaries included (-a): a path left by __FILE__ or the debug information
+# names the machine that built it (CMakeLists.txt maps both trees away with -ffile-prefix-map).
+named=$(grep -rlaF -e "$src" -e "$build" "$prefix" || true)
+if [ -n "$named" ]; then
+  for f in $named; do
+    echo "$f: $(grep -aoF -e "$src" -e "$build" "$f" | wc -l) occurrences, e.g." \
+         "$(strings -a "$f" | grep -F -e "$src" -e "$build" | head -n1)" >&2
+  done
+  fail "the installed files above name the source or build tree"
 fi
+echo "no installed file ($(find "$prefix" -type f | wc -l) of them) names $src or $build"
 cp -r "$src/tests/consumer" "$work/consumer"
 
 echo "== find_package(umbra) from the prefix"
