@@ -9,7 +9,7 @@ build=${1:-build}
 
 packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-headers opencl-c-headers
           pocl-opencl-icd libteem-dev libopenimageio-dev libnifti2-dev libcjson-dev
-          libgdcm-dev libtiff-dev libexpat1-dev libcmocka-dev gnuplot-nox python3-dev
+          libtiff-dev libexpat1-dev libcmocka-dev gnuplot-nox python3-dev
           python3-venv python3-numpy python3-pytest python3-nibabel python3-pil python3-pydicom)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,22 +1,28 @@
 // SPDX-License-Identifier: Apache-2.0
 /* io/dicom.cpp: volumes from DICOM: a series (a list of files, or a directory's files, see
- * io/series.c) or one single-frame file, with GDCM (Debian's libgdcm-dev) decoding compressed
- * pixel data.
+ * io/series.c) or one single-frame file.
  *
  * A series is read in two passes. The first walks each file's structure with umbra's own bounded
- * parser (io/dicom_parse.c, which also says why GDCM's parser is not used) and checks that the
- * files make one volume: one SeriesInstanceUID, one size, one pixel layout (greyscale, 8 or 16
- * bits allocated), one orientation (ImageOrientationPatient) and pixel spacing. Slices are
- * sorted by their position (ImagePositionPatient) along the slice normal, row direction x column
- * direction, and must lie on one line along it (no gantry tilt: that would be a sheared grid) at
- * uniform steps (each within 1% of a step of its place; missing slices or mixed thicknesses are
- * refused, naming the slice): the spacing is that step, not SliceThickness. The world transform is
- * DICOM's patient space (LPS millimetres) as written: origin the first slice's position, index
- * axes the row direction, the column direction and the normal; spacing x the column spacing
- * (PixelSpacing[1]), y the row spacing (PixelSpacing[0]). The second pass reads each slice's
- * pixels (uncompressed: straight from the file; compressed: the fragments the walk located,
- * handed to GDCM's decoder for the transfer syntax: JPEG, JPEG-LS, JPEG 2000, RLE) and converts
- * them into the volume's buffer.
+ * parser (io/dicom_parse.c) and checks that the files make one volume: one SeriesInstanceUID, one
+ * size, one pixel layout (greyscale, 8 or 16 bits allocated), one orientation
+ * (ImageOrientationPatient) and pixel spacing. Slices are sorted by their position
+ * (ImagePositionPatient) along the slice normal, row direction x column direction, and must lie
+ * on one line along it (no gantry tilt: that would be a sheared grid) at uniform steps (each
+ * within 1% of a step of its place; missing slices or mixed thicknesses are refused, naming the
+ * slice): the spacing is that step, not SliceThickness. The world transform is DICOM's patient
+ * space (LPS millimetres) as written: origin the first slice's position, index axes the row
+ * direction, the column direction and the normal; spacing x the column spacing (PixelSpacing[1]),
+ * y the row spacing (PixelSpacing[0]). The second pass reads each slice's pixels (uncompressed:
+ * straight from the file; RLE Lossless: decoded here) and converts them into the volume's buffer.
+ *
+ * Why no DICOM library. Debian 12's GDCM (libgdcm-dev 3.0.21) was tried first and cannot take
+ * untrusted files: it is built with its assertions on, and its parser aborts the process on a file
+ * cut inside an element header (gdcm::ExplicitDataElement::ReadPreValue); libFuzzer on
+ * tests/fuzz/fuzz_volume then found its RLE decoder reading past its input (a SEGV in
+ * gdcm::RLECodec::DecodeByStreams, seed regress_gdcm_rle_overread) and its JPEG decoder
+ * dereferencing NULL (gdcm::JPEGCodec::Decode, seed regress_gdcm_jpeg_null) within two minutes
+ * each. So umbra reads the structure and RLE itself, bounded, and refuses JPEG, JPEG-LS and
+ * JPEG 2000 data as unsupported, naming the transfer syntax.
  *
  * Values: each slice's RescaleSlope and RescaleIntercept are applied (per slice). Without any
  * rescale the stored type is kept (uint8, uint16, int16; int8 becomes int16). With integer slopes
@@ -26,10 +32,7 @@
  * functional groups this reader does not read).
  *
  * Hostile files: uncompressed pixel data must hold every pixel, and compressed pixel data may
- * claim at most 1032 times its bytes (deflate's largest expansion), before anything is
- * allocated; at most 65536 files. GDCM's exceptions are caught; GDCM's trace output (its
- * warnings and errors on std::cerr) is switched off around every decode, under one lock, as the
- * NIfTI reader does for nifticlib: the flags are process-wide. */
+ * claim at most 1032 times its bytes, before anything is allocated; at most 65536 files. */
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -37,55 +40,20 @@
 #include <cstdlib>
 #include <cstring>
 #include <sys/types.h>
-#include <mutex>
 #include <new>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <gdcmDataElement.h>
-#include <gdcmFragment.h>
-#include <gdcmImage.h>
-#include <gdcmSequenceOfFragments.h>
-#include <gdcmTrace.h>
-#include <gdcmTransferSyntax.h>
 
 #include "dicom.h"
 
 namespace {
 
 constexpr size_t DICOM_MAX_FILES = 65536;
+constexpr const char *RLE_LOSSLESS = "1.2.840.10008.1.2.5";
 constexpr double DICOM_MAX_RATIO = 1032.0;
 /* A slice may sit at most this fraction of the step from its place on the uniform grid. */
 constexpr double DICOM_POSITION_TOLERANCE = 0.01;
-
-std::mutex gdcm_lock;
-
-/* Holds the lock with GDCM's trace switched off; restores the flags afterwards. */
-class quiet_gdcm {
-public:
-    quiet_gdcm() : guard_(gdcm_lock)
-    {
-        debug_ = gdcm::Trace::GetDebugFlag();
-        warning_ = gdcm::Trace::GetWarningFlag();
-        error_ = gdcm::Trace::GetErrorFlag();
-        gdcm::Trace::SetDebug(false);
-        gdcm::Trace::SetWarning(false);
-        gdcm::Trace::SetError(false);
-    }
-    ~quiet_gdcm()
-    {
-        gdcm::Trace::SetDebug(debug_);
-        gdcm::Trace::SetWarning(warning_);
-        gdcm::Trace::SetError(error_);
-    }
-    quiet_gdcm(const quiet_gdcm &) = delete;
-    quiet_gdcm &operator=(const quiet_gdcm &) = delete;
-
-private:
-    std::lock_guard<std::mutex> guard_;
-    bool debug_, warning_, error_;
-};
 
 /* One file's header, as the first pass reads it. */
 struct slice_header {
@@ -202,6 +170,13 @@ umbra_status read_header(umbra_context ctx, const char *func, const std::string 
         return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\": RescaleSlope is 0", func,
                            path.c_str());
     }
+    if (h.encapsulated && h.syntax != RLE_LOSSLESS) {
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: \"%s\": transfer syntax %s (JPEG, JPEG-LS or JPEG 2000) is not "
+                           "decoded: the decoders at hand (GDCM's) crash on malformed data; "
+                           "decompress the series first (gdcmconv --raw, dcmdjpeg)",
+                           func, path.c_str(), h.syntax.c_str());
+    }
     /* The pixel data's claim against the file, before anything is allocated. */
     double claim = (double)h.rows * h.cols * h.frames * (h.bits_allocated / 8);
     double have = 0;
@@ -259,8 +234,61 @@ umbra_status read_bytes(dicom_load &L, const std::string &path, FILE *f, uint64_
     return UMBRA_SUCCESS;
 }
 
-/* One file's pixels into buf (resized): uncompressed read straight from the file, compressed
- * through GDCM's decoder for the transfer syntax, given only the fragments umbra located. */
+/* DICOM RLE Lossless (PS3.5 annex G) of one frame, decoded by umbra (see the top of the file). The fragment starts
+ * with 16 little-endian uint32: the segment count (one per byte of a sample, most significant
+ * first) and each segment's offset; each segment is PackBits of rows x columns bytes. Returns
+ * NULL on success, else what is wrong. */
+const char *rle_decode(const std::vector<char> &in, const slice_header &h, char *out)
+{
+    const size_t n = (size_t)h.rows * h.cols, planes = h.bits_allocated / 8;
+    const unsigned char *p = reinterpret_cast<const unsigned char *>(in.data());
+    uint32_t header[16];
+    if (in.size() < 64) {
+        return "the RLE header is cut short";
+    }
+    for (int i = 0; i < 16; ++i) {
+        header[i] = (uint32_t)p[4 * i] | (uint32_t)p[4 * i + 1] << 8 |
+                    (uint32_t)p[4 * i + 2] << 16 | (uint32_t)p[4 * i + 3] << 24;
+    }
+    if (header[0] != planes) {
+        return "the RLE segment count does not match BitsAllocated";
+    }
+    for (size_t s = 0; s < planes; ++s) {
+        size_t at = header[1 + s], end = s + 1 < planes ? header[2 + s] : in.size(), got = 0;
+        if (at < 64 || at > end || end > in.size()) {
+            return "an RLE segment offset lies outside the fragment";
+        }
+        while (got < n) {
+            if (at >= end) {
+                return "an RLE segment ends before its plane is full";
+            }
+            int c = (signed char)p[at++];
+            if (c >= 0) {
+                size_t run = (size_t)c + 1;
+                if (run > end - at || run > n - got) {
+                    return "an RLE literal run overruns its segment or plane";
+                }
+                for (size_t k = 0; k < run; ++k, ++got) {
+                    out[got * planes + (planes - 1 - s)] = (char)p[at + k];
+                }
+                at += run;
+            } else if (c != -128) {
+                size_t run = (size_t)(1 - c);
+                if (at >= end || run > n - got) {
+                    return "an RLE replicate run overruns its segment or plane";
+                }
+                for (size_t k = 0; k < run; ++k, ++got) {
+                    out[got * planes + (planes - 1 - s)] = (char)p[at];
+                }
+                ++at;
+            }
+        }
+    }
+    return nullptr;
+}
+
+/* One file's pixels into buf (resized): uncompressed read straight from the file, RLE decoded
+ * here from the fragment umbra located; other compressed syntaxes refused (see the top). */
 umbra_status decode(dicom_load &L, const slice_header &h, std::vector<char> &buf)
 {
     size_t want = (size_t)h.rows * h.cols * h.frames * (h.bits_allocated / 8);
@@ -284,48 +312,31 @@ umbra_status decode(dicom_load &L, const slice_header &h, std::vector<char> &buf
         }
         return st;
     }
-    gdcm::SmartPointer<gdcm::SequenceOfFragments> sq = new gdcm::SequenceOfFragments;
-    std::vector<char> bytes;
-    for (const auto &fr : h.fragments) {
-        bytes.resize((size_t)fr.second);
-        st = read_bytes(L, h.path, f, fr.first, bytes.size(), bytes.data());
-        if (st != UMBRA_SUCCESS) {
-            std::fclose(f);
-            return st;
+    if (h.syntax == RLE_LOSSLESS) {
+        std::vector<char> frag;
+        const char *why = h.fragments.size() == 1 ? nullptr
+                                                  : "RLE has one fragment per frame, the file more";
+        if (!why) {
+            frag.resize((size_t)h.fragments[0].second);
+            st = read_bytes(L, h.path, f, h.fragments[0].first, frag.size(), frag.data());
         }
-        gdcm::Fragment frag;
-        frag.SetByteValue(bytes.data(), (uint32_t)bytes.size());
-        sq->AddFragment(frag);
+        std::fclose(f);
+        if (st == UMBRA_SUCCESS && !why) {
+            why = rle_decode(frag, h, buf.data());
+        }
+        if (st == UMBRA_SUCCESS && why) {
+            st = umbra__fail(L.ctx, UMBRA_ERROR_FORMAT,
+                             "%s: \"%s\": cannot decode the RLE pixel data: %s", L.func,
+                             h.path.c_str(), why);
+        }
+        if (st == UMBRA_SUCCESS && h.bits_allocated == 16 && umbra__host_is_big_endian()) {
+            umbra__swap_bytes(buf.data(), want / 2, 2);
+        }
+        return st;
     }
     std::fclose(f);
-    gdcm::DataElement pixels(gdcm::Tag(0x7fe0, 0x0010));
-    pixels.SetVR(gdcm::VR::OB);
-    pixels.SetValue(*sq);
-    gdcm::Image img;
-    img.SetNumberOfDimensions(2);
-    img.SetDimension(0, h.cols);
-    img.SetDimension(1, h.rows);
-    img.SetPixelFormat(gdcm::PixelFormat(1, (unsigned short)h.bits_allocated,
-                                         (unsigned short)h.bits_stored,
-                                         (unsigned short)h.high_bit,
-                                         (unsigned short)h.pixel_rep));
-    img.SetPhotometricInterpretation(h.photometric == "MONOCHROME1"
-                                         ? gdcm::PhotometricInterpretation::MONOCHROME1
-                                         : gdcm::PhotometricInterpretation::MONOCHROME2);
-    img.SetTransferSyntax(gdcm::TransferSyntax::GetTSType(h.syntax.c_str()));
-    img.SetDataElement(pixels);
-    bool ok;
-    {
-        quiet_gdcm quiet;
-        ok = img.GetBufferLength() == want && img.GetBuffer(buf.data());
-    }
-    if (!ok) {
-        return umbra__fail(L.ctx, UMBRA_ERROR_FORMAT,
-                           "%s: \"%s\": GDCM cannot decode the pixel data (transfer syntax %s; "
-                           "corrupt, or a syntax GDCM does not decode?)",
-                           L.func, h.path.c_str(), h.syntax.c_str());
-    }
-    return UMBRA_SUCCESS;
+    return umbra__fail(L.ctx, UMBRA_ERROR_UNSUPPORTED, "%s: \"%s\": transfer syntax %s", L.func,
+                       h.path.c_str(), h.syntax.c_str()); /* read_header refused it already */
 }
 
 /* Stored sample i of a decoded buffer, masked to BitsStored (and sign-extended). */
@@ -400,7 +411,7 @@ umbra_status fill_dicom(void *user, void *dst, size_t bytes)
         return umbra__fail(L.ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory decoding DICOM",
                            L.func);
     } catch (const std::exception &e) {
-        return umbra__fail(L.ctx, UMBRA_ERROR_FORMAT, "%s: GDCM failed: %.200s", L.func, e.what());
+        return umbra__fail(L.ctx, UMBRA_ERROR_FORMAT, "%s: reading DICOM failed: %.200s", L.func, e.what());
     }
     return UMBRA_SUCCESS;
 }
@@ -629,8 +640,8 @@ extern "C" umbra_status umbra__volume_load_dicom(umbra_context ctx, const char *
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory reading DICOM",
                            func);
     } catch (const std::exception &e) {
-        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: GDCM failed: %.200s", func, e.what());
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: reading DICOM failed: %.200s", func, e.what());
     } catch (...) {
-        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: GDCM failed", func);
+        return umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: reading DICOM failed", func);
     }
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* io/dicom.h: what io/dicom_parse.c (umbra's own bounded walk over a DICOM file's structure) and
- * io/dicom.cpp (series assembly, GDCM's decoders) share. */
+ * io/dicom.cpp (series assembly, pixel decoding) share. */
 #ifndef UMBRA_IO_DICOM_H
 #define UMBRA_IO_DICOM_H
 
@@ -17,7 +17,7 @@ extern "C" {
 /* One file's attributes as umbra reads them; the has_* flags say which were present. */
 typedef struct umbra__dicom_file {
     char syntax[68];          /* TransferSyntaxUID (0002,0010) */
-    int encapsulated;         /* compressed pixel data: fragments, for GDCM's decoders */
+    int encapsulated;         /* compressed pixel data, in fragments */
     char series[68];          /* SeriesInstanceUID (0020,000E) */
     char photometric[20];     /* PhotometricInterpretation (0028,0004) */
     unsigned rows, cols, bits_allocated, bits_stored, high_bit, pixel_rep, samples, frames;

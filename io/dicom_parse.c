@@ -1,11 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* io/dicom_parse.c: umbra's own walk over a DICOM file's structure (PS3.5 chapter 7, PS3.10
- * chapter 7), so that no byte of an untrusted file reaches a parser that aborts on it.
- *
- * Why not GDCM's parser: Debian builds GDCM with its assertions on, and its reader asserts (and
- * in places calls abort()) on malformed input: a file cut inside an element header stops the
- * process in gdcm::ExplicitDataElement::ReadPreValue. So umbra reads the structure itself,
- * strictly and bounded, and hands GDCM only compressed pixel fragments to decode (io/dicom.cpp).
+ * chapter 7), bounded, so that no byte of an untrusted file reaches a parser that aborts on it
+ * (io/dicom.cpp says why no DICOM library reads it).
  *
  * What is walked: the 128-byte preamble and "DICM"; the file meta group (explicit VR little
  * endian) for the transfer syntax; the data set in implicit or explicit VR little endian, its

@@ -4,7 +4,7 @@
  * presets, images to and from PNG and EXR.
  *
  * It is a library of its own (libumbra_io, CMake target umbra::io, pkg-config umbra-io) that links
- * Teem, OpenImageIO, nifticlib, cJSON, GDCM, libtiff and expat, so that libumbra itself depends
+ * Teem, OpenImageIO, nifticlib, cJSON, libtiff and expat, so that libumbra itself depends
  * on OpenCL and the C library only. It is built on libumbra's public API: whatever it loads an
  * application could also hand to umbra_volume_create or umbra_transfer_function_create itself.
  * Errors are recorded on the context like every umbra error. Readers open regular files only. */
@@ -112,10 +112,11 @@ UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *pa
 UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
                                                    umbra_volume *out);
 
-/* Loads a DICOM volume through GDCM: count files of one series in any order, one directory (its
- * files, DICOMDIR and names starting with '.' passed over, subdirectories not entered), or one
- * file (one slice, or a multi-frame image placed by GDCM's geometry). Greyscale, 8 or 16 bits
- * allocated, any transfer syntax GDCM decodes. Slices are sorted by ImagePositionPatient along
+/* Loads a DICOM volume (Part 10 files, read by umbra itself: see the README): count files of one
+ * series in any order, one directory (its files, DICOMDIR and names starting with '.' passed
+ * over, subdirectories not entered), or one single-frame file. Greyscale, 8 or 16 bits
+ * allocated; implicit or explicit VR little endian, uncompressed or RLE Lossless (JPEG, JPEG-LS,
+ * JPEG 2000, multi-frame and big-endian files are UMBRA_ERROR_UNSUPPORTED). Slices are sorted by ImagePositionPatient along
  * the slice normal and must be one series (SeriesInstanceUID), one size and pixel layout, one
  * orientation, on one line along the normal (no gantry tilt) at uniform steps (each within 1% of a
  * step of its place): the z spacing is that step, x and y PixelSpacing's column and row spacing.
