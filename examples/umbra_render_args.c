@@ -162,7 +162,9 @@ static const fixed_option fixed[] = {
     {"scene", OPT_SCENE, "NAME", "built-in scene: spheres (default), slab, marschner-lobb"},
     {"scene-size", OPT_SCENE_SIZE, "N", "built-in scene resolution N^3 (default per scene)"},
     {"volume", OPT_VOLUME, "FILE", "volume file: .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI), "
-                                   ".mha/.mhd (MetaImage), .dat (Voreen)"},
+                                   ".mha/.mhd (MetaImage), .dat (Voreen), .dcm or a DICOM "
+                                   "series directory, .tif/.tiff (a stack, OME-TIFF too) or a "
+                                   "directory of them"},
     {"allow-data-root", OPT_DATA_ROOT, "DIR", "a header's detached data file may also lie under "
                                               "DIR (repeatable; by default only in the header's "
                                               "own directory)"},
