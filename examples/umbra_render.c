@@ -6,7 +6,8 @@
  * written (checked before rendering), a request the technique cannot do; 2 on a failure of the
  * device or of memory (no device, an OpenCL error, out of memory), or when writing the image fails
  * after the render; 130 when interrupted (Ctrl-C stops the render between two pieces of device
- * work). */
+ * work). The command line and the scene set up from it are shared with umbra-view
+ * (umbra_render.h). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -19,9 +20,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "umbra/io.h"
+#include "umbra_render.h"
 
-static void usage(FILE *f)
+void usage(FILE *f)
 {
     fprintf(f,
         "usage: umbra-render [options]\n"
@@ -185,7 +186,7 @@ static int check_output(const char *path)
 /* Exit status for a failed library call, as the README states: 1 for bad input (an argument out
  * of range, a file that cannot be read or is malformed, a request the technique cannot do), 2 for
  * a failure of the device or of memory. */
-static int exit_status(umbra_status st)
+int exit_status(umbra_status st)
 {
     switch (st) {
     case UMBRA_SUCCESS: return 0;
@@ -392,17 +393,7 @@ static int parse_args(int argc, char **argv, options *o)
     return check_output(o->out);
 }
 
-/* Everything the render needs; released in one place. */
-typedef struct session {
-    umbra_context ctx;
-    umbra_scene scene;
-    umbra_volume volume;
-    umbra_transfer_function tf, light_tf;
-    umbra_renderer renderer;
-    float *pixels;
-} session;
-
-static void session_end(session *s)
+void session_end(session *s)
 {
     free(s->pixels);
     umbra_renderer_release(s->renderer);
@@ -428,7 +419,9 @@ static umbra_status load_tf(umbra_context ctx, const char *path, const char *pre
     return umbra_transfer_function_load(ctx, path, out);
 }
 
-static int run(const options *o, session *s)
+/* Everything up to a renderer ready to render: context, volume, transfer functions, camera,
+ * light, options and shadow technique, kept in s (umbra_render.h). Returns an exit status. */
+static int session_begin(const options *o, session *s)
 {
     umbra_context_desc cd;
     umbra_context_desc_init(&cd);
@@ -549,6 +542,31 @@ static int run(const options *o, session *s)
         (st = umbra_renderer_set_options(r, &rd)) ||
         (st = umbra_renderer_set_shadow(r, &o->shadow)))
         return exit_status(st);
+    s->view_volume = vol;
+    s->view_tf = tf;
+    s->camera = cam;
+    s->light = light;
+    s->options = rd;
+    s->shadow = o->shadow;
+    s->width = o->width;
+    s->height = o->height;
+    s->out = o->out;
+    return 0;
+}
+
+int session_open(int argc, char **argv, session *s)
+{
+    options o;
+    int rc = parse_args(argc, argv, &o);
+    return rc ? rc : session_begin(&o, s);
+}
+
+static int run(const options *o, session *s)
+{
+    int rc = session_begin(o, s);
+    if (rc)
+        return rc;
+    umbra_renderer r = s->renderer;
     s->pixels = malloc((size_t)o->width * o->height * 4 * sizeof(float));
     if (!s->pixels) {
         fprintf(stderr, "umbra-render: out of memory for a %ux%u image\n", o->width, o->height);
@@ -591,7 +609,7 @@ static int run(const options *o, session *s)
     return 0;
 }
 
-int main(int argc, char **argv)
+int umbra_render_main(int argc, char **argv)
 {
     options o;
     if (parse_args(argc, argv, &o) != 0)
@@ -602,3 +620,10 @@ int main(int argc, char **argv)
     session_end(&s);
     return rc;
 }
+
+#ifndef UMBRA_RENDER_NO_MAIN
+int main(int argc, char **argv)
+{
+    return umbra_render_main(argc, argv);
+}
+#endif
