@@ -283,6 +283,8 @@ void section_tf(viewer *v)
         ImGui::Text("%u entries over the volume's range", v->tf_count);
     if (ImGui::Button("reset"))
         viewer_tf_load(v, v->preset);
+    if (v->s.light_tf)
+        ImGui::TextDisabled("(the light pass keeps --light-tf)");
 }
 
 void draw_panel(viewer *v)
