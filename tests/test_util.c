@@ -2,6 +2,7 @@
 /* tests/test_util.c: see test_util.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "internal.h" /* test_read_voxels reads the volume's device copy */
+#include "conformance.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -76,18 +77,7 @@ void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expect
 double test_path_in_box(const double p[3], const double dir[3], const double half[3],
                         double t_max)
 {
-    double lo = 0.0, hi = t_max;
-    for (int a = 0; a < 3; ++a) {
-        if (dir[a] == 0.0) {
-            if (p[a] < -half[a] || p[a] > half[a])
-                return 0.0;
-            continue;
-        }
-        double ta = (-half[a] - p[a]) / dir[a], tb = (half[a] - p[a]) / dir[a];
-        lo = fmax(lo, fmin(ta, tb));
-        hi = fmin(hi, fmax(ta, tb));
-    }
-    return hi > lo ? hi - lo : 0.0;
+    return conf_path_in_box(p, dir, half, t_max);
 }
 
 float *test_read_voxels(umbra_volume vol)
@@ -192,20 +182,8 @@ umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t n
 umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                 const float *data, uint32_t brick_size)
 {
-    umbra_volume_desc d;
-    umbra_volume_desc_init(&d);
-    d.data = data;
-    d.type = UMBRA_FLOAT32;
-    d.dims[0] = nx;
-    d.dims[1] = ny;
-    d.dims[2] = nz;
-    d.value_range_given = 1;
-    d.value_min = 0.0f;
-    d.value_max = 1.0f;
-    if (brick_size)
-        d.brick_size = brick_size;
     umbra_volume v = NULL;
-    assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
+    assert_int_equal(conf_volume_of(ctx, nx, ny, nz, data, brick_size, &v), UMBRA_SUCCESS);
     return v;
 }
 
@@ -250,24 +228,12 @@ umbra_renderer test_renderer_transmission(umbra_context ctx, umbra_volume volume
 
 umbra_light test_directional_light(float x, float y, float z)
 {
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
+    return conf_directional(x, y, z);
 }
 
 umbra_light test_point_light(float x, float y, float z)
 {
-    umbra_light l = test_directional_light(0.0f, -1.0f, 0.0f);
-    l.type = UMBRA_LIGHT_POINT;
-    l.position[0] = x;
-    l.position[1] = y;
-    l.position[2] = z;
-    return l;
+    return conf_point(x, y, z);
 }
 
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha)

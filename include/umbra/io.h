@@ -26,55 +26,87 @@ extern "C" {
  * (MetaImage), .dat (Voreen). */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
-/* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, relative to the header unless
- * absolute): types uchar, ushort, short and float; 3-D, or 4-D with a size-1 first axis; encodings
- * raw, gzip, zrl, ascii and hex. With "space directions" the spacing is each direction's length
- * and the volume carries the index-to-world transform (space origin, 0 where absent, and the unit
- * directions); a sheared grid is UMBRA_ERROR_UNSUPPORTED. Without them the spacing comes from the
- * header's spacings (1 where absent) and the box is centred. Teem parses the header, umbra reads
- * the data. Header and data must be regular files (a FIFO or device is UMBRA_ERROR_IO, never
- * waited on); the declared sizes are checked against the data before anything is allocated: raw
- * data must fill the rest of its file exactly, gzip can expand at most 1032:1 and zrl 16384:1
- * (else UMBRA_ERROR_FORMAT naming both sizes). */
+/* The data-file policy. A NRRD ("data file"), MetaImage (ElementDataFile) or Voreen .dat
+ * (ObjectFileName) header names a second file holding the voxels. However it is named (relative
+ * to the header, absolute, through ".." or symbolic links), that file must resolve (realpath)
+ * inside the header's own directory, or inside one of data_roots; anything else is
+ * UMBRA_ERROR_IO naming the file, where it resolves to and the header's directory, and nothing
+ * of it is read. So a header from elsewhere (an upload) cannot make umbra read another file of
+ * the machine. umbra_volume_load and the readers below allow the header's directory only; NRRD
+ * and MetaImage data split over several files (LIST, printf-style names) are refused. */
+typedef struct umbra_volume_load_options {
+    size_t struct_size;             /* sizeof(umbra_volume_load_options); set by
+                                       umbra_volume_load_options_init */
+    const char *const *data_roots;  /* borrowed for the call: directories (each resolved with
+                                       realpath, so it must exist) that data files may also lie
+                                       in; "/" allows any file. NULL (default): none */
+    size_t data_root_count;         /* entries of data_roots, at most 1024 (default 0) */
+} umbra_volume_load_options;
+
+/* Fills options with the defaults (struct_size included); NULL is a no-op. */
+UMBRA_API void umbra_volume_load_options_init(umbra_volume_load_options *options);
+
+/* umbra_volume_load with options (NULL: the defaults, as umbra_volume_load); options are read
+ * during the call only. A malformed options struct (struct_size, a NULL or empty root, more than
+ * 1024) or a root that cannot be resolved is UMBRA_ERROR_INVALID_ARGUMENT. */
+UMBRA_API umbra_status umbra_volume_load_with_options(umbra_context ctx, const char *path,
+                                                      const umbra_volume_load_options *options,
+                                                      umbra_volume *out);
+
+/* Loads NRRD, attached (.nrrd) or detached (.nhdr + one data file, named relative to the header,
+ * under the data-file policy above): types uchar, ushort, short and float; 3-D, or 4-D with a
+ * size-1 first axis; encodings raw, gzip, zrl, ascii and hex. With "space directions" the spacing
+ * is each direction's length and the volume carries the index-to-world transform (space origin, 0
+ * where absent, and the unit directions); a sheared grid is UMBRA_ERROR_UNSUPPORTED. Without them
+ * the spacing comes from the header's spacings (1 where absent) and the box is centred. Teem parses
+ * the header, umbra reads the data. Header and data must be regular files (a FIFO or device is
+ * UMBRA_ERROR_IO, never waited on); the declared sizes are checked against the data before anything
+ * is allocated: raw data must fill the rest of its file exactly, gzip can expand at most 1032:1 and
+ * zrl 16384:1 (else UMBRA_ERROR_FORMAT naming both sizes). */
 UMBRA_API umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path,
                                               umbra_volume *out);
 
-/* Loads a Voreen .dat header and its raw file (both regular files), which is looked up relative
- * to the .dat's directory. ObjectFileName, Resolution, SliceThickness and Format (UCHAR, USHORT,
- * SHORT, FLOAT) are required; ObjectModel, if present, must be I. SliceThickness is the
- * spacing; the format has no origin, so the box is centred. */
+/* Loads a Voreen .dat header and its raw file (both regular files), which is looked up relative to
+ * the .dat's directory, under the data-file policy above. ObjectFileName, Resolution,
+ * SliceThickness and Format (UCHAR, USHORT, SHORT, FLOAT) are required; ObjectModel, if present,
+ * must be I. SliceThickness is the spacing; the format has no origin, so the box is centred. */
 UMBRA_API umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path,
                                              umbra_volume *out);
 
-/* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz) through
- * nifticlib. 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and
- * float32 are kept; int8 becomes int16; int32, uint32, int64, uint64 and float64 become float32
- * (rounded to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope
- * other than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's
- * real values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform
- * (when sform_code > 0), else the qform (qform_code > 0), else pixdim (nifticlib reads 0 as 1), in
- * the file's units; the sform (else the qform) also places the volume in the file's world (its
- * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). The header's sizes are
- * checked against the file before the voxels are read. */
+/* Loads a single-file NIfTI-1 or NIfTI-2 volume (.nii, or gzip-compressed .nii.gz), either byte
+ * order; umbra reads the header and the voxels itself (nifticlib gives the quaternion formula).
+ * 3-D, or with every dimension past the third of size 1. Types uint8, uint16, int16 and float32
+ * are kept; int8 becomes int16; int32, uint32, int64, uint64 and float64 become float32 (rounded
+ * to the nearest float); complex and RGB types are UMBRA_ERROR_UNSUPPORTED. A scl_slope other
+ * than 0 (or 1 with scl_inter 0) gives float32 voxels slope * stored + inter, the file's real
+ * values (e.g. Hounsfield units). Spacing is the length of each index axis under the sform (when
+ * sform_code > 0), else the qform (qform_code > 0), else pixdim (0 read as 1), in the file's
+ * units; the sform (else the qform) also places the volume in the file's world (its
+ * index-to-world transform; a sheared one is UMBRA_ERROR_UNSUPPORTED). UMBRA_ERROR_FORMAT, naming
+ * the field and its value: a sizeof_hdr other than 348 or 540, a magic other than "n+1" or
+ * "n+2" ("ni1" pairs are UMBRA_ERROR_UNSUPPORTED), a vox_offset that is not a whole number of
+ * bytes past the header, a NaN or infinite scl_slope, scl_inter, pixdim[0..3] or qform/sform
+ * number, and any float voxel (after scaling) that is not finite. The header's sizes are checked
+ * against the file before the voxels are read. */
 UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path,
                                                umbra_volume *out);
 
-/* Loads a MetaImage volume (ITK's format): .mha with the voxels after the header
- * (ElementDataFile = LOCAL) or .mhd naming one data file (.raw, or zlib/gzip-compressed .zraw),
- * relative to the header unless absolute; header and data must be regular files. NDims 3, one
+/* Loads a MetaImage volume (ITK's format): .mha with the voxels after the header (ElementDataFile =
+ * LOCAL) or .mhd naming one data file (.raw, or zlib/gzip-compressed .zraw), relative to the
+ * header, under the data-file policy above; header and data must be regular files. NDims 3, one
  * channel; BinaryData True; byte order from BinaryDataByteOrderMSB / ElementByteOrderMSB;
  * CompressedData with or without CompressedDataSize; HeaderSize (a count of bytes to skip, or -1:
  * the voxels end the file) for uncompressed data files. MET_UCHAR, MET_USHORT, MET_SHORT and
  * MET_FLOAT are kept; MET_CHAR becomes int16; MET_INT, MET_UINT, MET_LONG, MET_ULONG,
  * MET_LONG_LONG, MET_ULONG_LONG and MET_DOUBLE become float32. Spacing is ElementSpacing (else
  * ElementSize, else 1). With Offset (or Position, Origin) or TransformMatrix (or Rotation,
- * Orientation; values 3a..3a+2 are index axis a's direction) the volume carries that
- * index-to-world transform, in the file's world as written (ITK's LPS); with neither the box is
- * centred. The sizes are checked against the file before any voxel buffer is allocated: raw data
- * must fill the rest of its file exactly, compressed data can expand at most 1032:1 and must end
- * exactly at the declared size; anything else, a repeated or malformed key, is
- * UMBRA_ERROR_FORMAT naming the value; what umbra does not read (several channels or files, ASCII
- * voxels, other types) is UMBRA_ERROR_UNSUPPORTED. */
+ * Orientation; values 3a..3a+2 are index axis a's direction) the volume carries that index-to-world
+ * transform, in the file's world as written (ITK's LPS); with neither the box is centred. The sizes
+ * are checked against the file before any voxel buffer is allocated: raw data must fill the rest of
+ * its file exactly, compressed data can expand at most 1032:1 and must end exactly at the declared
+ * size; anything else, a repeated or malformed key, is UMBRA_ERROR_FORMAT naming the value; what
+ * umbra does not read (several channels or files, ASCII voxels, other types) is
+ * UMBRA_ERROR_UNSUPPORTED. */
 UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
                                                    umbra_volume *out);
 

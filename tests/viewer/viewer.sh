@@ -11,11 +11,14 @@
 #                shading, --no-gui
 #   options      the command line, without a window: the viewer's own options refused with
 #                exit 1 and a message naming the value, umbra-render's options and files
-#                checked by umbra-render's parser, no display is exit 2
-#   light_orbit  the spheres with CSSM and the panel shown: --frames 6 --orbit light replays a full
-#                turn of the light; every frame must print its times and have rebuilt the map
-#                (the light moved), then the last frame, outside the panel, must match
-#                umbra-render given the view the viewer prints (its light as it ended)
+#                checked by umbra-render's parser (one getopt_long table: prefixes, --opt=value,
+#                a prefix of a viewer option and an umbra-render one refused as ambiguous), every
+#                message naming umbra-view, no display is exit 2
+#   light_orbit  the spheres with CSSM (7 taps, a 128^2 map) and the panel shown: --frames 6
+#                --orbit light replays a full turn of the light; every frame must print its times
+#                and have rebuilt the map (the light moved), then the last frame, outside the
+#                panel, must match umbra-render given the view the viewer prints (its light as it
+#                ended, the technique's parameters by their registry keys)
 set -euo pipefail
 case=${1:?usage: viewer.sh CASE UMBRA_VIEW UMBRA_RENDER SOURCE_DIR}
 view=$(realpath "$2")
@@ -65,8 +68,8 @@ volume)
     ;;
 light_orbit)
     frames=6
-    run_view --scene spheres --technique cssm --size 512x288 --frames $frames --orbit light \
-        --snapshot view.png
+    run_view --scene spheres --technique cssm --taps 7 --map-size 128 --size 512x288 \
+        --frames $frames --orbit light --snapshot view.png
     n=$(grep -c '^frame [0-9]*/'$frames': ' view.out || true)
     [ "$n" -eq $frames ] || fail "$n frame lines, expected $frames"
     # Every frame rebuilt the map: the light moved each frame.
@@ -75,6 +78,9 @@ light_orbit)
     grep -q "^median of $frames frames (light orbit" view.out || fail "no median line"
     viewargs=$(sed -n 's/^view: //p' view.out)
     [ -n "$viewargs" ] || fail "the viewer printed no view"
+    for want in "--technique cssm" "--taps 7" "--map-size 128" "--ray-block 0"; do
+        grep -qe " $want" <<<" $viewargs" || fail "the view lacks $want: $viewargs"
+    done
     panel=$(sed -n 's/.*panel at \([0-9]*\),\([0-9]*\) size \([0-9]*\)x\([0-9]*\).*/\1,\2,\3,\4/p' \
             view.err)
     [ -n "$panel" ] || fail "the snapshot names no panel rectangle"
@@ -89,7 +95,9 @@ options)
         local want=$1 needle=$2 got=0
         shift 2
         timeout 60 "$view" "$@" >out 2>&1 || got=$?
-        if [ "$got" -ne "$want" ] || ! grep -qF -- "$needle" out; then
+        # What umbra-render's parser or set-up prints names the program it runs in.
+        if [ "$got" -ne "$want" ] || ! grep -qF -- "$needle" out || grep -q '^umbra-render:' out
+        then
             sed 's/^/    /' out
             fail "umbra-view $* exited with $got (want $want), looked for: $needle"
         fi
@@ -99,15 +107,24 @@ options)
     expect 0 "--technique NAME" --help
     expect 0 "umbra-view $(sed -n 's/^project(umbra VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")" \
         --version
-    expect 1 "--frames '0' is not a whole number in [1, 100000]" --frames 0
+    expect 0 "--map-size auto|N" --help
+    expect 1 "umbra-view: --frames '0' is not a whole number in [1, 100000]" --frames 0
+    expect 1 "umbra-view: --frames '0' is not a whole number in [1, 100000]" --fram=0
+    expect 1 "umbra-view: --snapshot 'a.jpg': the name must end in .png" --snap a.jpg
+    expect 1 "umbra-view: option '--no-g' is ambiguous: --no-gui, --no-ground" --no-g
+    expect 1 "umbra-view: --no-gui takes no value" --no-gui=1
     expect 1 "--frames '12x' is not a whole number" --frames 12x
     expect 1 "--frames '-3' is not a whole number" --frames -3
     expect 1 "--orbit 'sun' is not camera or light" --orbit sun
     expect 1 "--snapshot 'a.jpg': the name must end in .png" --snapshot a.jpg
     expect 1 "--snapshot needs a value" --snapshot
-    expect 1 "unknown option '--bogus'" --bogus
-    expect 1 "--size '0x10' is not WxH" --size 0x10
-    expect 1 "nope.nrrd" --volume nope.nrrd
+    expect 1 "umbra-view: unknown option '--bogus'" --bogus
+    expect 1 "umbra-view: --size '0x10' is not WxH" --size 0x10
+    expect 1 "umbra-view: --out 'x.jpg': the extension must be .png or .exr" --out x.jpg
+    expect 1 "umbra-view: UMBRA_ERROR_INVALID_ARGUMENT: umbra_shadow_desc_set_param: deep" \
+        --technique deep --nodes 1
+    expect 1 "umbra-view: UMBRA_ERROR_IO: umbra_volume_load_nrrd: cannot open \"nope.nrrd\"" \
+        --volume nope.nrrd
     # No display: the window cannot open, a failure (2) that says so.
     got=0
     env -u DISPLAY -u WAYLAND_DISPLAY timeout 60 "$view" --scene-size 16 --size 16x16 >out 2>&1 ||

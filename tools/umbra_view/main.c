@@ -32,7 +32,7 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
-/* ---- the viewer's own options; the rest go to umbra-render's parser ---------------------------- */
+/* ---- the viewer's own options, in umbra-render's parser's table (umbra_render.h) ----------- */
 
 typedef struct view_options {
     const char *snapshot; /* --snapshot OUT.png */
@@ -41,74 +41,51 @@ typedef struct view_options {
     int orbit_light;      /* --orbit light (else camera) */
 } view_options;
 
-static void view_usage(FILE *f)
-{
-    fprintf(f,
-        "usage: umbra-view [options]   (interactive; every umbra-render option below applies)\n"
-        "  --snapshot OUT.png    render until the shadows are full quality, write the window's\n"
-        "                        pixels to OUT.png and exit\n"
-        "  --frames N            replay an orbit of N frames (a full turn), print each frame's\n"
-        "                        times, then exit (or take the --snapshot)\n"
-        "  --orbit camera|light  what the replay turns about the vertical (default camera)\n"
-        "  --no-gui              hide the panel (G or Tab shows it)\n"
-        "  --size WxH is the window's size; --out FILE is where S writes the frame.\n"
-        "  Mouse: left orbit, middle or shift+left pan, wheel zoom, right or ctrl+left light.\n"
-        "  Keys: S save frame, G/Tab panel, P print view options, R reset view, Esc quit.\n\n");
-    usage(f);
-}
+enum { VIEW_OPT_SNAPSHOT, VIEW_OPT_FRAMES, VIEW_OPT_ORBIT, VIEW_OPT_NO_GUI };
 
-/* Takes the viewer's options out of argv (kept in order for umbra-render's parser, *argc
- * updated). Returns 0, 1 on bad input (printed), or -1 when --help/--version was answered. */
-static int view_parse(int *argc, char **argv, view_options *o)
+static const program_option view_option_list[] = {
+    [VIEW_OPT_SNAPSHOT] = {"snapshot", "OUT.png", "render until the shadows are full quality, "
+                                                  "write the window's pixels to OUT.png and exit"},
+    [VIEW_OPT_FRAMES] = {"frames", "N", "replay an orbit of N frames (a full turn), print each "
+                                        "frame's times, then exit (or take the --snapshot)"},
+    [VIEW_OPT_ORBIT] = {"orbit", "camera|light", "what the replay turns about the vertical "
+                                                 "(default camera)"},
+    [VIEW_OPT_NO_GUI] = {"no-gui", NULL, "hide the panel (G or Tab shows it)"},
+};
+
+/* program.take: one of the viewer's options. */
+static int view_take(void *user, size_t index, const char *v)
 {
-    memset(o, 0, sizeof *o);
-    int n = 1;
-    for (int i = 1; i < *argc; ++i) {
-        const char *a = argv[i], *v = i + 1 < *argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            view_usage(stdout);
-            return -1;
-        } else if (strcmp(a, "--version") == 0) {
-            printf("umbra-view %s (library %s)\n", UMBRA_VERSION_STRING, umbra_version());
-            return -1;
-        } else if (strcmp(a, "--no-gui") == 0) {
-            o->no_gui = 1;
-        } else if (strcmp(a, "--snapshot") == 0 || strcmp(a, "--frames") == 0 ||
-                   strcmp(a, "--orbit") == 0) {
-            if (!v) {
-                fprintf(stderr, "umbra-view: %s needs a value\n", a);
-                return 1;
-            }
-            ++i;
-            if (strcmp(a, "--snapshot") == 0) {
-                size_t len = strlen(v);
-                if (len < 5 || strcmp(v + len - 4, ".png") != 0) {
-                    fprintf(stderr, "umbra-view: --snapshot '%s': the name must end in .png\n", v);
-                    return 1;
-                }
-                o->snapshot = v;
-            } else if (strcmp(a, "--frames") == 0) {
-                char *end;
-                unsigned long f = strspn(v, "0123456789") == strlen(v) ? strtoul(v, &end, 10) : 0;
-                if (f < 1 || f > 100000) {
-                    fprintf(stderr, "umbra-view: --frames '%s' is not a whole number in "
-                                    "[1, 100000]\n", v);
-                    return 1;
-                }
-                o->frames = (uint32_t)f;
-            } else if (strcmp(v, "camera") == 0 || strcmp(v, "light") == 0) {
-                o->orbit_light = strcmp(v, "light") == 0;
-            } else {
-                fprintf(stderr, "umbra-view: --orbit '%s' is not camera or light\n", v);
-                return 1;
-            }
-        } else {
-            argv[n++] = argv[i];
+    view_options *o = user;
+    switch (index) {
+    case VIEW_OPT_SNAPSHOT: {
+        size_t len = strlen(v);
+        if (len < 5 || strcmp(v + len - 4, ".png") != 0) {
+            fprintf(stderr, "umbra-view: --snapshot '%s': the name must end in .png\n", v);
+            return 1;
         }
+        o->snapshot = v;
+        return 0;
     }
-    argv[n] = NULL;
-    *argc = n;
-    return 0;
+    case VIEW_OPT_FRAMES: {
+        unsigned long f = strspn(v, "0123456789") == strlen(v) ? strtoul(v, NULL, 10) : 0;
+        if (f < 1 || f > 100000) {
+            fprintf(stderr, "umbra-view: --frames '%s' is not a whole number in [1, 100000]\n",
+                    v);
+            return 1;
+        }
+        o->frames = (uint32_t)f;
+        return 0;
+    }
+    case VIEW_OPT_ORBIT:
+        if (strcmp(v, "camera") != 0 && strcmp(v, "light") != 0) {
+            fprintf(stderr, "umbra-view: --orbit '%s' is not camera or light\n", v);
+            return 1;
+        }
+        o->orbit_light = strcmp(v, "light") == 0;
+        return 0;
+    default: o->no_gui = 1; return 0;
+    }
 }
 
 /* ---- transfer function: presets and the edited table --------------------------------------------- */
@@ -264,7 +241,8 @@ void viewer_save_frame(viewer *v)
 }
 
 /* The view as umbra-render options (with the same input options, umbra-render renders this
- * frame). */
+ * frame): camera, light, rendering options, and the technique with every one of its parameters
+ * as umbra-render's parser reads them (param_option_text). */
 static void print_view(const viewer *v, FILE *f)
 {
     const umbra_camera *c = &v->s.camera;
@@ -281,9 +259,22 @@ static void print_view(const viewer *v, FILE *f)
     fprintf(f, " --light-%s %.9g,%.9g,%.9g --light-color %.9g,%.9g,%.9g",
             l->type == UMBRA_LIGHT_POINT ? "pos" : "dir", p[0], p[1], p[2], l->color[0],
             l->color[1], l->color[2]);
-    fprintf(f, " --step %.9g %s %s %s\n", o->step, o->shading ? "--shading" : "--no-shading",
+    fprintf(f, " --step %.9g %s %s %s%s", o->step, o->shading ? "--shading" : "--no-shading",
             o->ground_plane ? "--ground" : "--no-ground",
-            o->transmission == UMBRA_TRANSMISSION_COLORED ? "--colored" : "--grey");
+            o->transmission == UMBRA_TRANSMISSION_COLORED ? "--colored" : "--grey",
+            o->preintegrated ? " --preintegrated" : "");
+    /* Every parameter of the technique, by its registry key. */
+    const umbra_technique_info *t = umbra_technique_find_id(v->s.shadow.technique);
+    for (uint32_t k = 0; t && k < t->param_count; ++k) {
+        const umbra_param_info *pi = umbra_technique_param_get(t, k);
+        double value;
+        char text[128];
+        if (umbra_shadow_desc_get_param(&v->s.shadow, t->name, pi->key, &value) == UMBRA_SUCCESS) {
+            param_option_text(pi, value, text, sizeof text);
+            fprintf(f, " %s", text);
+        }
+    }
+    fputc('\n', f);
     fflush(f);
 }
 
@@ -551,7 +542,7 @@ static int run(viewer *v, const view_options *o)
                 break;
             }
             if (st != UMBRA_SUCCESS && (replaying || o->snapshot)) {
-                rc = exit_status(st); /* umbra-render's message is on stderr */
+                rc = exit_status(st); /* the library's message is on stderr */
                 break;
             }
         }
@@ -632,15 +623,24 @@ static void on_glfw_error(int code, const char *message)
 int main(int argc, char **argv)
 {
     view_options o;
-    int rc = view_parse(&argc, argv, &o);
+    memset(&o, 0, sizeof o);
+    const program prog = {
+        "umbra-view",
+        "interactive; every umbra-render option applies: --size WxH is the window's size, --out "
+        "FILE is where S writes the frame. Mouse: left orbit, middle or shift+left pan, wheel "
+        "zoom, right or ctrl+left light. Keys: S save frame, G/Tab panel, P print view options, "
+        "R reset view, Esc quit.",
+        view_option_list, sizeof view_option_list / sizeof view_option_list[0], view_take, &o};
+    options args;
+    int rc = parse_args_as(&prog, argc, argv, &args);
     if (rc)
-        return rc < 0 ? 0 : rc;
+        return rc;
     viewer v;
     memset(&v, 0, sizeof v);
     v.preset = -1;
     v.show_panel = !o.no_gui;
     present_init(&v.pr);
-    if ((rc = session_open(argc, argv, &v.s)) != 0)
+    if ((rc = session_begin(&args, &v.s)) != 0)
         goto done;
     umbra_volume_info info;
     umbra_volume_get_info(v.s.view_volume, &info);

@@ -2,8 +2,9 @@
 // tools/umbra_view/panel.cpp: umbra-view's panel, Dear ImGui with Debian's GLFW and OpenGL 3
 // backends (libimgui-dev builds both into libimgui.a). The frame itself is drawn as the first
 // thing of the GUI's draw list, 1:1 from the texture present.c filled; the panel then goes over
-// it. The technique section walks the table of techniques_panel.h and names no technique or
-// parameter itself. Everything it edits goes into the viewer's copies of the settings and marks
+// it. The technique section walks the technique registry (umbra/registry.h): every technique and
+// every parameter with its type, range or allowed values, what 0 means and its doc come from
+// there, so it names no technique or parameter itself. Everything it edits goes into the viewer's copies of the settings and marks
 // them changed; main.c sets them on the renderer before the next frame.
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -16,7 +17,6 @@
 #include <cstdio>
 #include <cstring>
 
-#include "techniques_panel.h"
 #include "view.h"
 
 namespace {
@@ -33,77 +33,136 @@ const char *base_name(const char *path)
     return slash ? slash + 1 : path;
 }
 
-void tooltip(const view_param *p)
+// A parameter's tooltip: its key, type and the description umbra-render's --help gives it.
+void tooltip(const umbra_param_info *p)
 {
-    if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("%s: %s (default %g)", p->name, p->doc, view_param_default(p));
+    if (!ImGui::IsItemHovered())
+        return;
+    char text[1024];
+    param_describe(p, text, sizeof text);
+    const char *type = p->type == UMBRA_PARAM_FLOAT  ? "number"
+                       : p->type == UMBRA_PARAM_UINT ? "whole number"
+                                                     : "on or off";
+    ImGui::SetTooltip("%s (%s%s): %s", p->key, type,
+                      p->flags & UMBRA_PARAM_REBUILDS ? ", rebuilds the shadow structure" : "",
+                      text);
 }
 
-// One control for parameter p of d, by its kind and range; true when the user changed it.
-bool param_control(umbra_shadow_desc *d, const view_param *p)
+// The parameter's value in d (technique t's); its default if the registry cannot read it.
+double param_value(const umbra_shadow_desc *d, const umbra_technique_info *t,
+                   const umbra_param_info *p)
 {
-    double value = view_param_get(d, p);
+    double value = p->default_value;
+    umbra_shadow_desc_get_param(d, t->name, p->key, &value);
+    return value;
+}
+
+// Sets the parameter through the registry, which checks it; a refusal is shown in the panel
+// and leaves d as it was.
+bool param_store(viewer *v, const umbra_technique_info *t, const umbra_param_info *p,
+                 double value)
+{
+    char msg[sizeof v->message];
+    if (umbra_shadow_desc_set_param(&v->s.shadow, t->name, p->key, value, msg, sizeof msg) !=
+        UMBRA_SUCCESS) {
+        std::snprintf(v->message, sizeof v->message, "%s", msg);
+        v->message_is_error = 1;
+        return false;
+    }
+    return true;
+}
+
+// The slider's ends: the range, moved in from a bound the range excludes.
+void param_bounds(const umbra_param_info *p, double *lo, double *hi)
+{
+    double inset = p->type == UMBRA_PARAM_FLOAT ? 1e-3 * (p->max - p->min) : 1.0;
+    *lo = p->flags & UMBRA_PARAM_MIN_EXCLUSIVE ? p->min + inset : p->min;
+    *hi = p->flags & UMBRA_PARAM_MAX_EXCLUSIVE ? p->max - inset : p->max;
+}
+
+// The value a parameter whose 0 has a meaning takes when its checkbox leaves 0: the default if
+// that is not 0, else the middle of the range (geometric for a positive range) or the middle
+// allowed value.
+double param_nonzero(const umbra_param_info *p)
+{
+    if (p->default_value != 0.0)
+        return p->default_value;
+    if (p->allowed)
+        return p->allowed[p->allowed_count / 2];
+    double lo, hi;
+    param_bounds(p, &lo, &hi);
+    double mid = lo > 0.0 ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+    return p->type == UMBRA_PARAM_FLOAT ? mid : std::round(mid);
+}
+
+// One control for parameter p of technique t, by its type and range; true when it changed.
+bool param_control(viewer *v, const umbra_technique_info *t, const umbra_param_info *p)
+{
+    const double value = param_value(&v->s.shadow, t, p);
     bool changed = false;
-    ImGui::PushID(p->name);
-    if (p->kind == VIEW_PARAM_BOOL) {
+    ImGui::PushID(p->key);
+    if (p->type == UMBRA_PARAM_BOOL) {
         bool b = value != 0.0;
-        if ((changed = ImGui::Checkbox(p->name, &b)))
-            view_param_set(d, p, b ? 1.0 : 0.0);
+        if (ImGui::Checkbox(p->key, &b))
+            changed = param_store(v, t, p, b ? 1.0 : 0.0);
         tooltip(p);
-    } else if (p->choices) {
-        char preview[32];
-        std::snprintf(preview, sizeof preview, "%g", value);
-        if (ImGui::BeginCombo(p->name, preview)) {
-            for (unsigned i = 0; i < p->n_choices; ++i) {
-                char item[32];
-                std::snprintf(item, sizeof item, "%u", p->choices[i]);
-                if (ImGui::Selectable(item, value == p->choices[i])) {
-                    view_param_set(d, p, p->choices[i]);
-                    changed = true;
-                }
+        ImGui::PopID();
+        return changed;
+    }
+    // A parameter whose 0 means "auto" (or the like) gets a checkbox for that in front of its
+    // control; the control then shows the meaning and is disabled.
+    const bool zero_allowed = (p->flags & UMBRA_PARAM_ZERO) != 0;
+    bool zero = zero_allowed && value == 0.0;
+    float width = ImGui::CalcItemWidth();
+    if (zero_allowed) {
+        if (ImGui::Checkbox("##zero", &zero))
+            changed = param_store(v, t, p, zero ? 0.0 : param_nonzero(p));
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("%s 0: %s", p->key, p->zero_doc);
+        ImGui::SameLine();
+        width -= ImGui::GetItemRectSize().x + ImGui::GetStyle().ItemInnerSpacing.x;
+    }
+    ImGui::SetNextItemWidth(std::max(width, 40.0f));
+    ImGui::BeginDisabled(zero);
+    const double shown = zero ? param_nonzero(p) : value;
+    const char *zero_text = p->zero_name ? p->zero_name : p->zero_doc;
+    if (p->allowed) {
+        char preview[64];
+        std::snprintf(preview, sizeof preview, "%g", shown);
+        if (ImGui::BeginCombo(p->key, zero ? zero_text : preview)) {
+            for (uint32_t i = 0; i < p->allowed_count; ++i) {
+                char item[40];
+                std::snprintf(item, sizeof item, "%g", p->allowed[i]);
+                if (ImGui::Selectable(item, value == p->allowed[i]))
+                    changed = param_store(v, t, p, p->allowed[i]);
             }
             ImGui::EndCombo();
         }
-        tooltip(p);
     } else {
-        // A parameter whose 0 means "auto" (or the like) gets a checkbox for that in front of
-        // its slider; the slider then shows the word and is disabled.
-        bool zero = p->zero && value == 0.0;
-        float width = ImGui::CalcItemWidth();
-        if (p->zero) {
-            if (ImGui::Checkbox("##zero", &zero)) {
-                view_param_set(d, p, zero ? 0.0 : p->nonzero);
-                changed = true;
-            }
-            if (ImGui::IsItemHovered())
-                ImGui::SetTooltip("%s: %s", p->name, p->zero);
-            ImGui::SameLine();
-            width -= ImGui::GetItemRectSize().x + ImGui::GetStyle().ItemInnerSpacing.x;
-        }
-        ImGui::SetNextItemWidth(std::max(width, 40.0f));
-        ImGui::BeginDisabled(zero);
-        ImGuiSliderFlags flags = p->logarithmic ? ImGuiSliderFlags_Logarithmic : 0;
+        double lo, hi;
+        param_bounds(p, &lo, &hi);
+        // A range over orders of magnitude gets a logarithmic slider. A value typed in
+        // (ctrl+click) is not clamped: the registry refuses one out of range and says why.
+        ImGuiSliderFlags flags =
+            lo > 0.0 && hi / lo >= 20.0 ? ImGuiSliderFlags_Logarithmic : ImGuiSliderFlags_None;
         bool edited;
-        if (p->kind == VIEW_PARAM_FLOAT) {
-            float f = zero ? (float)p->nonzero : (float)view_param_get(d, p);
-            edited = ImGui::SliderFloat(p->name, &f, (float)p->min, (float)p->max,
-                                        zero ? p->zero : "%.3g", flags);
+        if (p->type == UMBRA_PARAM_FLOAT) {
+            float f = (float)shown;
+            edited = ImGui::SliderFloat(p->key, &f, (float)lo, (float)hi,
+                                        zero ? zero_text : "%.3g", flags);
             if (edited)
-                view_param_set(d, p, f);
+                changed = param_store(v, t, p, f);
         } else {
-            uint32_t u = zero ? (uint32_t)p->nonzero : (uint32_t)view_param_get(d, p);
-            uint32_t lo = (uint32_t)p->min, hi = (uint32_t)p->max;
-            edited = p->max - p->min > 1e6
-                         ? ImGui::InputScalar(p->name, ImGuiDataType_U32, &u)
-                         : ImGui::SliderScalar(p->name, ImGuiDataType_U32, &u, &lo, &hi,
-                                               zero ? p->zero : "%u", flags);
+            uint32_t u = (uint32_t)shown, ulo = (uint32_t)lo, uhi = (uint32_t)hi;
+            edited = hi - lo > 1e6 ? ImGui::InputScalar(p->key, ImGuiDataType_U32, &u)
+                                   : ImGui::SliderScalar(p->key, ImGuiDataType_U32, &u, &ulo,
+                                                         &uhi, zero ? zero_text : "%u", flags);
             if (edited)
-                view_param_set(d, p, u);
+                changed = param_store(v, t, p, u);
         }
-        ImGui::EndDisabled();
-        tooltip(p);
-        changed = changed || edited;
     }
+    ImGui::EndDisabled();
+    tooltip(p);
     ImGui::PopID();
     return changed;
 }
@@ -121,8 +180,7 @@ void section_status(viewer *v)
                         timing_name(s.render_timing));
     ImGui::Text("shadow memory %.2f MiB", (double)s.shadow_memory_bytes / 1048576.0);
     if (s.map_size)
-        ImGui::Text("map %u x %u%s", s.map_size, s.map_size,
-                    v->s.shadow.map_size == UMBRA_MAP_SIZE_AUTO ? " (auto)" : "");
+        ImGui::Text("map %u x %u", s.map_size, s.map_size);
     if (s.slices)
         ImGui::Text("slices %u", s.slices);
     ImGui::Text("light channels %u", s.light_channels);
@@ -140,24 +198,34 @@ void section_status(viewer *v)
 void section_technique(viewer *v)
 {
     umbra_shadow_desc *d = &v->s.shadow;
-    if (ImGui::BeginCombo("technique", umbra_shadow_technique_name(d->technique))) {
-        for (unsigned i = 0; i < view_technique_count(); ++i) {
-            umbra_shadow_technique t = view_technique_at(i);
-            if (ImGui::Selectable(umbra_shadow_technique_name(t), t == d->technique)) {
-                d->technique = t;
+    const umbra_technique_info *current = umbra_technique_find_id(d->technique);
+    if (ImGui::BeginCombo("technique", current ? current->name : "?")) {
+        for (uint32_t i = 0; i < umbra_technique_count(); ++i) {
+            const umbra_technique_info *t = umbra_technique_get(i);
+            if (ImGui::Selectable(t->name, t == current)) {
+                d->technique = t->id;
                 v->changed |= VIEW_CHANGED_SHADOW;
             }
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip("%s: %s\n\n%s", t->name, t->title, t->doc);
         }
         ImGui::EndCombo();
     }
-    unsigned n = 0;
-    const view_param *const *params = view_technique_params(d->technique, &n);
-    for (unsigned i = 0; i < n; ++i)
-        if (param_control(d, params[i]))
+    if (!current)
+        return;
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextDisabled("%s", current->title);
+    ImGui::PopTextWrapPos();
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("%s", current->doc);
+    for (uint32_t k = 0; k < current->param_count; ++k)
+        if (param_control(v, current, umbra_technique_param_get(current, k)))
             v->changed |= VIEW_CHANGED_SHADOW;
-    if (n && ImGui::Button("defaults")) {
-        for (unsigned i = 0; i < n; ++i)
-            view_param_set(d, params[i], view_param_default(params[i]));
+    if (current->param_count && ImGui::Button("defaults")) {
+        for (uint32_t k = 0; k < current->param_count; ++k) {
+            const umbra_param_info *p = umbra_technique_param_get(current, k);
+            param_store(v, current, p, p->default_value);
+        }
         v->changed |= VIEW_CHANGED_SHADOW;
     }
 }
@@ -200,6 +268,14 @@ void section_render(viewer *v)
         o->transmission = colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
         v->changed |= VIEW_CHANGED_OPTIONS;
     }
+    bool preintegrated = o->preintegrated;
+    if (ImGui::Checkbox("pre-integrated", &preintegrated)) {
+        o->preintegrated = preintegrated;
+        v->changed |= VIEW_CHANGED_OPTIONS;
+    }
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("pre-integrated segments along the view ray (and the convolution "
+                          "technique's light)");
     if (ImGui::SliderFloat("step", &o->step, 0.05f, 4.0f, "%.3g voxels",
                            ImGuiSliderFlags_Logarithmic))
         v->changed |= VIEW_CHANGED_OPTIONS;
