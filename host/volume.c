@@ -637,6 +637,7 @@ umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
     out->channels = v->channels;
     out->labels = v->labels;
     out->version = v->version;
+    out->type = v->input_type;
     for (uint32_t c = 0; c < UMBRA_MAX_CHANNELS; ++c) {
         out->channel_min[c] = c < v->channels ? v->channel_range[c][0] : 0.0f;
         out->channel_max[c] = c < v->channels ? v->channel_range[c][1] : 0.0f;

@@ -278,8 +278,9 @@ typedef struct umbra_clip_desc {
                                 origin (|d| / |(a, b, c)|) */
     int crop;                /* nonzero: keep only the crop box too (default 0) */
     float crop_min[3], crop_max[3]; /* the crop box in voxel coordinates, voxel (i, j, k)'s centre
-                                at (i, j, k), so [-0.5, dims - 0.5] is the whole volume (the
-                                default): finite, min <= max per axis */
+                                at (i, j, k), so [-0.5, dims - 0.5] is the whole volume
+                                (umbra_clip_desc_init sets 0; read only with crop): finite,
+                                min <= max per axis */
 } umbra_clip_desc;
 
 /* Fills desc with the defaults beside each field (nothing clipped; struct_size included); NULL

@@ -141,6 +141,8 @@ typedef struct umbra_volume_info {
     float channel_min[UMBRA_MAX_CHANNELS], channel_max[UMBRA_MAX_CHANNELS]; /* each channel's
                                 value range (unused channels 0) */
     uint64_t version;        /* 0 when made, one more for each umbra_volume_update */
+    umbra_scalar_type type;  /* the voxels' type as given at creation (umbra_volume_update's
+                                data is of this type) */
 } umbra_volume_info;
 
 /* Describes volume in *out (sizes, world placement, value range, device memory).
