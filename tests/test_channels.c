@@ -183,28 +183,7 @@ static umbra_renderer channel_renderer(umbra_volume vol, umbra_transfer_function
     return r;
 }
 
-static float *render(umbra_renderer r, uint32_t w, uint32_t h)
-{
-    float *img = malloc((size_t)w * h * 4 * sizeof *img);
-    assert_non_null(img);
-    if (umbra_renderer_render(r, w, h, img) != UMBRA_SUCCESS)
-        fail_msg("render: %s", umbra_context_last_message(ctx));
-    return img;
-}
 
-static float max_diff(const float *a, const float *b, size_t n, double *mean)
-{
-    float m = 0.0f;
-    double sum = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const float e = fabsf(a[i] - b[i]);
-        m = e > m ? e : m;
-        sum += e;
-    }
-    if (mean)
-        *mean = sum / (double)n;
-    return m;
-}
 
 #define W 48
 #define H 40
@@ -222,9 +201,9 @@ static void test_clear_channel_changes_nothing(void **state)
         for (int colored = 0; colored < 2; ++colored) {
             umbra_renderer r2 = channel_renderer(two, a, clear, ti->id, colored);
             umbra_renderer r1 = channel_renderer(one, a, NULL, ti->id, colored);
-            float *i2 = render(r2, W, H), *i1 = render(r1, W, H);
+            float *i2 = test_render_image(r2, W, H), *i1 = test_render_image(r1, W, H);
             double mean;
-            const float d = max_diff(i1, i2, (size_t)W * H * 4, &mean);
+            const float d = test_max_diff(i1, i2, (size_t)W * H * 4, &mean);
             print_message("%s colored %d: max %.3g mean %.3g\n", ti->name, colored, d, mean);
             /* The reference integrates one channel exactly and a mixture by the midpoint rule. */
             if (ti->id == UMBRA_SHADOW_REFERENCE)
@@ -257,9 +236,9 @@ static void test_same_data_renders_as_the_mixture(void **state)
         const umbra_technique_info *ti = umbra_technique_get(t);
         umbra_renderer r2 = channel_renderer(two, a, b, ti->id, 1);
         umbra_renderer r1 = channel_renderer(one, m, NULL, ti->id, 1);
-        float *i2 = render(r2, W, H), *i1 = render(r1, W, H);
+        float *i2 = test_render_image(r2, W, H), *i1 = test_render_image(r1, W, H);
         double mean;
-        const float d = max_diff(i1, i2, (size_t)W * H * 4, &mean);
+        const float d = test_max_diff(i1, i2, (size_t)W * H * 4, &mean);
         print_message("%s: two channels vs their mixture: max %.3g mean %.3g\n", ti->name, d,
                       mean);
         /* The reference integrates one channel exactly and a mixture by the midpoint rule; a
@@ -401,7 +380,7 @@ static void test_channel_ranges_and_image_sampler(void **state)
     /* The same render on a context of the image sampler (the channels stay one buffer). */
     umbra_transfer_function a = make_tf(tf_a, 4), b = make_tf(tf_b, 4);
     umbra_renderer r = channel_renderer(v, a, b, UMBRA_SHADOW_THRESHOLD, 0);
-    float *img = render(r, W, H);
+    float *img = test_render_image(r, W, H);
     umbra_context_desc cd;
     umbra_context_desc_init(&cd);
     cd.sampler = UMBRA_SAMPLER_IMAGE;
@@ -434,7 +413,7 @@ static void test_channel_ranges_and_image_sampler(void **state)
     float *iimg = malloc((size_t)W * H * 4 * sizeof *iimg);
     assert_non_null(iimg);
     assert_int_equal(umbra_renderer_render(ir, W, H, iimg), UMBRA_SUCCESS);
-    assert_true(max_diff(img, iimg, (size_t)W * H * 4, NULL) <= 1e-6f);
+    assert_true(test_max_diff(img, iimg, (size_t)W * H * 4, NULL) <= 1e-6f);
     free(img);
     free(iimg);
     umbra_renderer_release(ir);

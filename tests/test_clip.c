@@ -125,29 +125,7 @@ static umbra_clip_desc scene_clip(int crop, int rotated)
     return c;
 }
 
-static float max_diff(const float *a, const float *b, size_t n, double *mean)
-{
-    float m = 0.0f;
-    double sum = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const float e = fabsf(a[i] - b[i]);
-        m = e > m ? e : m;
-        sum += e;
-    }
-    if (mean)
-        *mean = sum / (double)n;
-    return m;
-}
 
-static float *render(umbra_renderer r, uint32_t w, uint32_t h)
-{
-    float *img = malloc((size_t)w * h * 4 * sizeof *img);
-    assert_non_null(img);
-    umbra_status st = umbra_renderer_render(r, w, h, img);
-    if (st != UMBRA_SUCCESS)
-        fail_msg("render: %s", umbra_context_last_message(ctx));
-    return img;
-}
 
 static void test_clipped_view_equals_zeroed_volume(void **state)
 {
@@ -167,13 +145,14 @@ static void test_clipped_view_equals_zeroed_volume(void **state)
                 umbra_light light = test_directional_light(1.0f, 0.1f, 0.05f);
                 umbra_renderer a = test_renderer(ctx, full, tf, &cam, &light, &o);
                 umbra_renderer b = test_renderer(ctx, zero, tf, &cam, &light, &o);
-                float *unclipped = render(a, 48, 40);
+                float *unclipped = test_render_image(a, 48, 40);
                 umbra_clip_desc c = scene_clip(crop, rotated);
                 assert_int_equal(umbra_renderer_set_clip(a, &c), UMBRA_SUCCESS);
-                float *clipped = render(a, 48, 40), *zeroed = render(b, 48, 40);
+                float *clipped = test_render_image(a, 48, 40);
+                float *zeroed = test_render_image(b, 48, 40);
                 const size_t n = (size_t)48 * 40 * 4;
-                const float d = max_diff(clipped, zeroed, n, NULL);
-                const float u = max_diff(clipped, unclipped, n, NULL);
+                const float d = test_max_diff(clipped, zeroed, n, NULL);
+                const float u = test_max_diff(clipped, unclipped, n, NULL);
                 print_message("rotated %d crop %d view %d: clipped vs zeroed %.3g, vs unclipped "
                               "%.3g\n", rotated, crop, v, d, u);
                 assert_true(d <= 1e-6f);
@@ -260,7 +239,7 @@ static void test_clipped_occluder_casts_no_shadow(void **state)
                     dark = g_full[i] > dark ? g_full[i] : dark;
                 }
                 double mean;
-                const float d = max_diff(r_clip, r_zero, 3 * RECEIVER_POINTS, &mean);
+                const float d = test_max_diff(r_clip, r_zero, 3 * RECEIVER_POINTS, &mean);
                 print_message("%s rotated %d crop %d: gap lit >= %.4f clipped, <= %.3f "
                               "unclipped; receiver vs zeroed max %.3g mean %.3g\n", ti->name,
                               rotated, crop, lit, dark, d, mean);
@@ -310,14 +289,14 @@ static void test_every_technique_image_clips_light_and_view(void **state)
         sd.technique = ti->id;
         assert_int_equal(umbra_renderer_set_shadow(a, &sd), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_set_shadow(b, &sd), UMBRA_SUCCESS);
-        float *unclipped = render(a, 64, 48);
+        float *unclipped = test_render_image(a, 64, 48);
         umbra_clip_desc c = scene_clip(0, 0);
         assert_int_equal(umbra_renderer_set_clip(a, &c), UMBRA_SUCCESS);
-        float *clipped = render(a, 64, 48), *zeroed = render(b, 64, 48);
+        float *clipped = test_render_image(a, 64, 48), *zeroed = test_render_image(b, 64, 48);
         double mean;
         const size_t n = (size_t)64 * 48 * 4;
-        const float d = max_diff(clipped, zeroed, n, &mean);
-        const float u = max_diff(clipped, unclipped, n, NULL);
+        const float d = test_max_diff(clipped, zeroed, n, &mean);
+        const float u = test_max_diff(clipped, unclipped, n, NULL);
         print_message("%s: clipped vs zeroed max %.3g mean %.3g; vs unclipped max %.3g\n",
                       ti->name, d, mean, u);
         assert_true(mean <= 0.004);
@@ -345,12 +324,12 @@ static void test_clip_rebuilds_and_costs_nothing_unset(void **state)
     sd.technique = UMBRA_SHADOW_THRESHOLD;
     assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
     umbra_render_stats st;
-    float *before = render(r, 32, 32);
+    float *before = test_render_image(r, 32, 32);
     /* An empty region is nothing clipped: the same image, bit for bit, no rebuild. */
     umbra_clip_desc c;
     umbra_clip_desc_init(&c);
     assert_int_equal(umbra_renderer_set_clip(r, &c), UMBRA_SUCCESS);
-    float *same = render(r, 32, 32);
+    float *same = test_render_image(r, 32, 32);
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
     assert_int_equal(st.shadow_rebuilt, 0);
     assert_memory_equal(before, same, (size_t)32 * 32 * 4 * sizeof(float));
@@ -360,20 +339,20 @@ static void test_clip_rebuilds_and_costs_nothing_unset(void **state)
     memcpy(c.crop_min, lo, sizeof lo);
     memcpy(c.crop_max, hi, sizeof hi);
     assert_int_equal(umbra_renderer_set_clip(r, &c), UMBRA_SUCCESS);
-    float *whole = render(r, 32, 32);
+    float *whole = test_render_image(r, 32, 32);
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
     assert_int_equal(st.shadow_rebuilt, 1);
-    assert_true(max_diff(before, whole, (size_t)32 * 32 * 4, NULL) <= 1e-6f);
+    assert_true(test_max_diff(before, whole, (size_t)32 * 32 * 4, NULL) <= 1e-6f);
     /* The plane rebuilds the map; a camera move then reuses it. */
     c = scene_clip(0, 0);
     assert_int_equal(umbra_renderer_set_clip(r, &c), UMBRA_SUCCESS);
-    free(render(r, 32, 32));
+    free(test_render_image(r, 32, 32));
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
     assert_int_equal(st.shadow_rebuilt, 1);
     const float dir[3] = {0.3f, 1.0f, 0.2f};
     umbra_camera cam = umbra_camera_orbit(dir, 55.0f, 30.0f);
     assert_int_equal(umbra_renderer_set_camera(r, &cam), UMBRA_SUCCESS);
-    free(render(r, 32, 32));
+    free(test_render_image(r, 32, 32));
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
     assert_int_equal(st.shadow_rebuilt, 0);
     /* NULL clears it: the first image again. */
