@@ -12,14 +12,14 @@ cd "$tmp" # a case that wrongly succeeds writes its default umbra.png here, not 
 failures=0
 small=(--scene-size 16 --size 16x16)
 
-# expect STATUS NEEDLE [--no-render] -- ARGS...: runs umbra-render ARGS (20 s at most: a FIFO
+# expect STATUS NEEDLE [--no-render] -- ARGS...: runs umbra-render ARGS (90 s at most: a FIFO
 # that blocks shows as a timeout) and checks its exit status and that stderr holds NEEDLE.
 expect() {
     local want=$1 needle=$2 no_render=0
     shift 2
     if [[ $1 == --no-render ]]; then no_render=1; shift; fi
     [[ $1 == -- ]] && shift
-    timeout 20 "$render" "$@" >"$tmp/out" 2>"$tmp/err"
+    timeout 90 "$render" "$@" >"$tmp/out" 2>"$tmp/err"
     local got=$?
     local ok=1
     [[ $got -eq $want ]] || ok=0
