@@ -214,6 +214,65 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 }
 #endif
 
+/* The eight voxels of the cell of voxel centres whose lowest corner is voxel i0 (i0 in
+ * [0, dims - 2], 0 on an axis of one voxel, where the cell repeats it), as sample_volume reads
+ * and normalises them, x fastest: c[x + 2 y + 4 z]. The trilinear interpolant inside the cell is
+ * then a blend of these (kernels/techniques/reference.cl integrates along a ray cell by cell). */
+#if UMBRA_SAMPLER_IMAGE
+/* Filtered reads at the voxel centres, where the filter's weights are 1 and 0: the texels. */
+UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
+{
+    const int3 i1 = min(i0 + 1, g.dims - 1);
+    for (int k = 0; k < 8; ++k) {
+        const int3 i = (int3)((k & 1) ? i1.x : i0.x, (k & 2) ? i1.y : i0.y, (k & 4) ? i1.z : i0.z);
+        c[k] = sample_volume(vol, g, g.box_min + (convert_float3(i) + 0.5f) * g.spacing);
+    }
+}
+#else
+UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
+{
+    int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_VOLUME_SLABS == 1
+    __global const UMBRA_VOXEL_T *restrict v = vol;
+#else
+    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    __global const UMBRA_VOXEL_T *v = vol_0;
+    v = s == 1 ? vol_1 : v;
+#if UMBRA_VOLUME_SLABS > 2
+    v = s == 2 ? vol_2 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 3
+    v = s == 3 ? vol_3 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 4
+    v = s == 4 ? vol_4 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 5
+    v = s == 5 ? vol_5 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 6
+    v = s == 6 ? vol_6 : v;
+#endif
+#if UMBRA_VOLUME_SLABS > 7
+    v = s == 7 ? vol_7 : v;
+#endif
+    i0.z -= s * UMBRA_SLAB_STEP;
+    i1.z -= s * UMBRA_SLAB_STEP;
+#endif
+    const size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+    const size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
+    const size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
+    float2 r[4] = {voxel_load2(v, g, z0 + y0 + i0.x), voxel_load2(v, g, z0 + y1 + i0.x),
+                   voxel_load2(v, g, z1 + y0 + i0.x), voxel_load2(v, g, z1 + y1 + i0.x)};
+    for (int k = 0; k < 4; ++k) {
+        /* one voxel along x: the second load is the next row's (or the pad), not this cell's */
+        const float x1 = i1.x == i0.x ? r[k].x : r[k].y;
+        c[2 * k] = voxel_blended(g, r[k].x);
+        c[2 * k + 1] = voxel_blended(g, x1);
+    }
+}
+#endif
+
 #if UMBRA_SAMPLER_IMAGE || UMBRA_VOLUME_SLABS > 1
 /* Central-difference gradient, one voxel each way, in value per world unit: six samples (on the
  * image back end six filtered reads, the texture hardware interpolates). A volume in several
