@@ -845,6 +845,32 @@ static view make_view(const cpu_scene *s, uint32_t w, uint32_t h)
     return v;
 }
 
+/* The light a sample of colour c at p on a view ray of direction d sends back, its shadow taken
+ * at light_at: only where there is a shadow to look up, as the kernel compiled without one
+ * does. */
+static v3 lit_sample(const prep *P, v3 p, v3 d, const float c[4], v3 light_at)
+{
+    const cpu_scene *s = P->s;
+    const umbra_render_desc *o = &s->opts;
+    v3 sf = s->shadow == UMBRA_SHADOW_REFERENCE ? shadow(P, light_at) : mk(1, 1, 1);
+    v3 light = vmul(from(s->light.color), sf);
+    v3 amb = from(o->ambient);
+    const int six = s->six_sample_shading;
+    v3 g = !o->shading ? mk(0, 0, 0) : six ? gradient_six_samples(P, p) : gradient(P, p);
+    float gl = sqrtf(dot(g, g));
+    if (!o->shading || !(gl > 1e-6f))
+        return vmul(mk(c[0], c[1], c[2]), add(amb, light));
+    v3 nrm = mul(g, -1.0f / gl);
+    float dist;
+    v3 l = to_light(P, p, &dist);
+    v3 hv = norm(add(l, mul(d, -1.0f)));
+    float diff = fabsf(dot(nrm, l));
+    float spec = six ? powf(fabsf(dot(nrm, hv)), o->shininess)
+                     : shading_power(fabsf(dot(nrm, hv)), o->shininess);
+    return add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
+               mul(light, o->ks * spec));
+}
+
 static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int px, int py,
                       float out[4])
 {
@@ -882,7 +908,34 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             walk w;
             walk_begin(P, &w, org, d, t0);
             float t_cell = -INFINITY; /* samples before it lie in a visible cell */
-            for (int k = 0; k < n;) {
+            int k = 0;
+            /* A jittered ray (kernels/raycast.cl): the unjittered first sample at t0, then the
+             * unjittered second, at t0 + h, cut to the fraction jitter of a step (its light at
+             * the fraction's mean emission depth from where that sample's segment begins), then
+             * the jittered samples from k = 1. */
+            if (jitter > 0.0f) {
+                for (int pre = 0; pre < 2 && A <= o->termination; ++pre) {
+                    float tp = t0 + (float)pre * hstep;
+                    if (!(tp < t1))
+                        break;
+                    v3 p = add(org, mul(d, tp));
+                    ++taken;
+                    lookup(P->view_tf, P->view_n, sample(P, p), c);
+                    float a = pre ? (c[3] < 1.0f ? -expm1f(jitter * log1pf(-c[3])) : 1.0f) : c[3];
+                    if (!(a > 0.0f))
+                        continue;
+                    float m = cpu_emission_depth(a);
+                    v3 at = pre ? add(p, mul(d, -0.5f * hstep * (1.0f + c[3]) + jitter * hstep * m))
+                                : add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep));
+                    v3 lit = lit_sample(P, p, d, c, at);
+                    col[0] += (1.0f - A) * a * lit.x;
+                    col[1] += (1.0f - A) * a * lit.y;
+                    col[2] += (1.0f - A) * a * lit.z;
+                    A += (1.0f - A) * a;
+                }
+                k = A > o->termination ? n : 1;
+            }
+            while (k < n) {
                 float t = t0 + ((float)k + jitter) * hstep;
                 if (o->empty_space_skipping && t >= t_cell) {
                     float t_in = walk_to_visible(P, &w, t, t1);
@@ -903,32 +956,10 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
                 if (c[3] > 0.0f) {
                     /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
-                     * a segment of opacity a (kernels/raycast.cl, shadow_point); only where
-                     * there is a shadow to look up, as the kernel compiled without one does. */
-                    v3 sf = mk(1, 1, 1);
-                    if (P->s->shadow == UMBRA_SHADOW_REFERENCE) {
-                        float a = c[3], m = cpu_emission_depth(a);
-                        sf = shadow(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
-                    }
-                    v3 light = vmul(from(s->light.color), sf);
-                    v3 amb = from(o->ambient);
-                    v3 lit;
-                    const int six = P->s->six_sample_shading;
-                    v3 g = !o->shading ? mk(0, 0, 0) : six ? gradient_six_samples(P, p) : gradient(P, p);
-                    float gl = sqrtf(dot(g, g));
-                    if (!o->shading || !(gl > 1e-6f)) {
-                        lit = vmul(mk(c[0], c[1], c[2]), add(amb, light));
-                    } else {
-                        v3 nrm = mul(g, -1.0f / gl);
-                        float dist;
-                        v3 l = to_light(P, p, &dist);
-                        v3 hv = norm(add(l, mul(d, -1.0f)));
-                        float diff = fabsf(dot(nrm, l));
-                        float spec = six ? powf(fabsf(dot(nrm, hv)), o->shininess)
-                                         : shading_power(fabsf(dot(nrm, hv)), o->shininess);
-                        lit = add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
-                                  mul(light, o->ks * spec));
-                    }
+                     * a segment of opacity a (kernels/raycast.cl, shadow_point). */
+                    float a = c[3], m = cpu_emission_depth(a);
+                    v3 at = add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep));
+                    v3 lit = lit_sample(P, p, d, c, at);
                     col[0] += (1.0f - A) * c[3] * lit.x;
                     col[1] += (1.0f - A) * c[3] * lit.y;
                     col[2] += (1.0f - A) * c[3] * lit.z;
