@@ -386,9 +386,14 @@ static void ray_box(const prep *P, v3 o, v3 d, float *t0, float *t1)
     float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
     float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, bmax[3] = {P->bmax.x, P->bmax.y, P->bmax.z};
     /* Multiplying by the reciprocal, as the kernel does, so both round alike: a one-ulp
-     * difference in the entry point can change the number of samples on a ray. A zero
-     * component gives +-inf (or NaN on a slab plane, which fminf/fmaxf drop). */
+     * difference in the entry point can change the number of samples on a ray. A ray parallel
+     * to an axis lies in its slab (faces included) for every t or for none. */
     for (int a = 0; a < 3; ++a) {
+        if (dd[a] == 0.0f) {
+            if (!(oo[a] >= bmin[a] && oo[a] <= bmax[a]))
+                lo = INFINITY, hi = -INFINITY;
+            continue;
+        }
         float inv = 1.0f / dd[a];
         float ta = (bmin[a] - oo[a]) * inv, tb = (bmax[a] - oo[a]) * inv;
         lo = fmaxf(lo, fminf(ta, tb));
