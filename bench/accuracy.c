@@ -28,8 +28,20 @@
 #include <unistd.h>
 
 #include "accuracy.h"
+#include "renderer_internal.h"
+#include "setting.h"
 
 /* ---- the settings swept ---------------------------------------------------------------------- */
+
+/* The sweep is the technique registry's: every technique's descriptor lists the settings it is
+ * measured at (host/renderer_internal.h, umbra__setting: its parameters as "key=value;...", a
+ * label, and whether it belongs to the quick sweep, the full one, a paper's table, the headline).
+ * The exact reference comes first (its image is every other row's yardstick), then none (the
+ * unshadowed frame every overhead is measured against), then each technique's settings in the
+ * registry's order. A scene marked `papers cssm` adds 2048^2 and 4096^2 maps for the CSSM
+ * paper's Tables 3-4, one marked `papers deep` the deep-map paper's Table 1 settings; on a 2-core
+ * CPU one 4096^2 build takes one to three minutes, so the large maps are measured where the
+ * papers' tables need them. */
 
 static config *add_config(config_list *L, umbra_shadow_technique t)
 {
@@ -42,6 +54,29 @@ static config *add_config(config_list *L, umbra_shadow_technique t)
     return c;
 }
 
+/* The setting's parameters in c (tests/setting.h). A setting the registry refuses is a bug of
+ * its table: reported, and left out. */
+static int apply_params(config *c, const char *params)
+{
+    char msg[1024];
+    if (setting_apply(&c->desc, &c->preintegrated, params, msg, sizeof msg) == 0)
+        return 0;
+    fprintf(stderr, "accuracy: %s\n", msg);
+    return -1;
+}
+
+static void add_exact_reference(config_list *L, float step)
+{
+    config *c = add_config(L, UMBRA_SHADOW_REFERENCE);
+    if (!c)
+        return;
+    c->desc.reference.step = step;
+    c->exact = 1;
+    c->headline = H_EXACT;
+    snprintf(c->label, sizeof c->label, "step %g (exact)", step);
+    snprintf(c->params, sizeof c->params, "reference_step=%g", step);
+}
+
 static void add_none(config_list *L)
 {
     config *c = add_config(L, UMBRA_SHADOW_NONE);
@@ -52,221 +87,44 @@ static void add_none(config_list *L)
     c->headline = H_NONE;
 }
 
-static void add_reference(config_list *L, float step, int exact)
+/* Whether a setting with these flags runs in this sweep, for a scene with these papers. */
+static int in_sweep(uint32_t flags, int quick, int papers)
 {
-    config *c = add_config(L, UMBRA_SHADOW_REFERENCE);
-    if (!c)
-        return;
-    c->desc.reference_step = step;
-    c->exact = exact;
-    snprintf(c->label, sizeof c->label, "step %g%s", step, exact ? " (exact)" : "");
-    snprintf(c->params, sizeof c->params, "reference_step=%g", step);
-    if (exact)
-        c->headline = H_EXACT;
-    else if (step == 1.0f)
-        c->headline = H_REF_COARSE;
+    if (quick)
+        return (flags & UMBRA__SWEEP_QUICK) != 0;
+    return (flags & UMBRA__SWEEP_FULL) ||
+           ((flags & UMBRA__SWEEP_PAPERS_CSSM) && (papers & SCENE_PAPERS_CSSM)) ||
+           ((flags & UMBRA__SWEEP_PAPERS_DEEP) && (papers & SCENE_PAPERS_DEEP));
 }
 
-/* "1024" or "auto" (UMBRA_MAP_SIZE_AUTO: the renderer chooses; the run's label and the CSV's
- * map_size column give the size chosen, from umbra_render_stats.map_size). */
-static const char *map_name(uint32_t map, char buf[16])
-{
-    if (map == UMBRA_MAP_SIZE_AUTO)
-        return "auto";
-    snprintf(buf, 16, "%u", map);
-    return buf;
-}
-
-static const char *map_label(uint32_t map, char buf[16])
-{
-    if (map == UMBRA_MAP_SIZE_AUTO)
-        return "auto size";
-    snprintf(buf, 16, "%u²", map);
-    return buf;
-}
-
-static void add_threshold(config_list *L, uint32_t map, uint32_t taps, float threshold)
-{
-    config *c = add_config(L, UMBRA_SHADOW_THRESHOLD);
-    if (!c)
-        return;
-    c->desc.map_size = map;
-    c->desc.taps = taps;
-    c->desc.threshold = threshold;
-    char a[16], b[16];
-    snprintf(c->label, sizeof c->label, "%s, opacity %g%s", map_label(map, a), threshold,
-             taps > 1 ? (taps == 7 ? ", 7 taps" : taps == 13 ? ", 13 taps" : ", 21 taps") : "");
-    snprintf(c->params, sizeof c->params, "map_size=%s;taps=%u;threshold=%g", map_name(map, b),
-             taps, threshold);
-    if (map == L->headline_map && taps == 1 && threshold == 0.5f)
-        c->headline = H_THRESHOLD;
-}
-
-/* ray_block 0 is the default block of texels per light ray; 1, a ray per texel (the paper's),
- * is labelled and named as such. */
-static config *add_cssm(config_list *L, uint32_t map, uint32_t taps, uint32_t ray_block)
-{
-    config *c = add_config(L, UMBRA_SHADOW_CSSM);
-    if (!c)
-        return NULL;
-    c->desc.map_size = map;
-    c->desc.taps = taps;
-    c->desc.ray_block = ray_block;
-    char a[16], b[16];
-    snprintf(c->label, sizeof c->label, "%s, %u taps%s", map_label(map, a), taps,
-             ray_block == 1 ? ", a ray per texel" : "");
-    snprintf(c->params, sizeof c->params, "map_size=%s;taps=%u;seed=%u%s", map_name(map, b), taps,
-             c->desc.seed, ray_block == 1 ? ";ray_block=1" : "");
-    if (map == L->headline_map && taps == 13 && ray_block == 0)
-        c->headline = H_CSSM;
-    return c;
-}
-
-static config *add_deep(config_list *L, uint32_t map, float eps, uint32_t nodes,
-                        uint32_t prefilter)
-{
-    config *c = add_config(L, UMBRA_SHADOW_DEEP);
-    if (!c)
-        return NULL;
-    c->desc.map_size = map;
-    c->desc.epsilon = eps;
-    c->desc.max_nodes = nodes;
-    c->desc.prefilter = prefilter;
-    char budget[32] = "";
-    if (nodes)
-        snprintf(budget, sizeof budget, ", %u nodes", nodes);
-    char a[16], b[16];
-    snprintf(c->label, sizeof c->label, "%s, ε %g%s%s", map_label(map, a), eps, budget,
-             prefilter == 5 ? ", 5-tap prefilter" : "");
-    snprintf(c->params, sizeof c->params, "map_size=%s;epsilon=%g;max_nodes=%u;prefilter=%u",
-             map_name(map, b), eps, nodes, prefilter);
-    if (map == L->headline_map && eps == 0.02f && prefilter == 1)
-        c->headline = nodes == 0 ? H_DEEP : nodes == 3 ? H_DEEP3 : 0;
-    return c;
-}
-
-/* An auto-size row made a draft: one texel per voxel (map_texels_per_voxel 1, what an application
- * asks for while the user drags the light), the threshold map's size, instead of the
- * technique's own. */
-static void make_draft(config *c)
-{
-    if (!c)
-        return;
-    c->desc.map_texels_per_voxel = 1.0f;
-    size_t n = strlen(c->label), m = strlen(c->params);
-    snprintf(c->label + n, sizeof c->label - n, ", draft");
-    snprintf(c->params + m, sizeof c->params - m, ";map_texels_per_voxel=1");
-}
-
-static void add_convolution(config_list *L, float slice, uint32_t sub, int pre)
-{
-    config *c = add_config(L, UMBRA_SHADOW_CONVOLUTION);
-    if (!c)
-        return;
-    c->desc.slice_distance = slice;
-    c->desc.subsamples = sub;
-    c->desc.preintegrated = pre;
-    const char *kind = pre ? (sub ? "pre-int. SCS" : "pre-int. ICS") : (sub ? "SCS" : "ICS");
-    snprintf(c->label, sizeof c->label, "%s slice %g%s", kind,
-             slice, sub ? (sub == 1 ? ", 1 sub-sample" : sub == 2 ? ", 2 sub-samples"
-                                                                  : ", 3 sub-samples")
-                        : "");
-    snprintf(c->params, sizeof c->params,
-             "slice_distance=%g;subsamples=%u;preintegrated=%d;cone_angle=%g", slice, sub, pre,
-             c->desc.cone_angle_degrees);
-    if (slice == 1.0f && sub == 0 && !pre)
-        c->headline = H_CONV;
-}
-
-/* The sweep. The exact reference comes first (its image is every other row's yardstick), then
- * none (the unshadowed frame every overhead is measured against). Maps are 512^2 and 1024^2 (the
- * headline size); a scene marked `papers cssm` adds 2048^2 and 4096^2 for the CSSM paper's
- * Tables 3-4 (threshold, deep with 3 nodes per channel, CSSM with 13 taps; unbounded deep maps up
- * to 2048^2), one marked `papers deep` the deep-map paper's Table 1 (128^2-512^2 at epsilon 0.02
- * and 0.06 with the 5-tap pre-filter). On a 2-core CPU one 4096^2 build takes one to three
- * minutes, so the large maps are measured where the papers' tables need them. CSSM and the deep
- * map also run at auto size as a draft (make_draft): what a dragged light costs in accuracy. */
+/* The sweep of one scene. Headline rows are numbered in the order they come: none, the exact
+ * reference, then each technique's. Light-space maps larger than max_map^2 are left out. */
 static void build_configs(int quick, int papers, uint32_t max_map, float exact_step,
                           config_list *L)
 {
-    /* auto (UMBRA_MAP_SIZE_AUTO) beside the fixed sizes, so every scene shows what it costs and
-     * loses against them; the quick sweep has 1024^2 too, the size auto is measured against. */
-    static const uint32_t maps_full[] = {UMBRA_MAP_SIZE_AUTO, 512, 1024, 2048, 4096};
-    static const uint32_t maps_quick[] = {UMBRA_MAP_SIZE_AUTO, 512, 1024};
-    const uint32_t *maps = quick ? maps_quick : maps_full;
-    size_t nmaps = quick ? 3 : (papers & SCENE_PAPERS_CSSM) ? 5 : 3;
     L->count = 0;
-    L->headline_map = quick ? 512 : 1024;
-    add_reference(L, exact_step, 1);
+    L->headline_count = H_FIRST_TECHNIQUE - 1;
+    add_exact_reference(L, exact_step);
     add_none(L);
-    if (quick) {
-        add_reference(L, 1.0f, 0);
-    } else {
-        add_reference(L, 0.5f, 0);
-        add_reference(L, 1.0f, 0);
-        add_reference(L, 2.0f, 0);
-    }
-    for (size_t i = 0; i < nmaps; ++i)
-        if (maps[i] <= max_map)
-            add_threshold(L, maps[i], 1, 0.5f);
-    if (!quick) {
-        /* 13 taps is the library's default (umbra_shadow_desc_init): auto with 13 taps is the
-         * threshold map an application gets unless it asks for another. */
-        add_threshold(L, UMBRA_MAP_SIZE_AUTO, 13, 0.5f);
-        add_threshold(L, 1024, 13, 0.5f);
-        add_threshold(L, 1024, 1, 0.25f);
-        add_threshold(L, 1024, 1, 0.75f);
-    }
-    for (size_t i = 0; i < nmaps; ++i)
-        if (maps[i] <= max_map)
-            add_cssm(L, maps[i], 13, 0);
-    make_draft(add_cssm(L, UMBRA_MAP_SIZE_AUTO, 13, 0));
-    add_cssm(L, L->headline_map, 7, 0);
-    if (!quick) {
-        add_cssm(L, 1024, 21, 0);
-        add_cssm(L, UMBRA_MAP_SIZE_AUTO, 13, 1); /* what sharing rays costs in accuracy */
-        add_cssm(L, 1024, 13, 1);
-    }
-    /* Unbounded deep maps stop at 2048^2: at 4096^2 one build takes about 3 minutes here. */
-    for (size_t i = 0; i < nmaps && i < 4; ++i)
-        if (maps[i] <= max_map)
-            add_deep(L, maps[i], 0.02f, 0, 1);
-    make_draft(add_deep(L, UMBRA_MAP_SIZE_AUTO, 0.02f, 0, 1));
-    add_deep(L, L->headline_map, 0.02f, 3, 1);
-    if (!quick) {
-        for (size_t i = 3; i < nmaps; ++i)
-            if (maps[i] <= max_map)
-                add_deep(L, maps[i], 0.02f, 3, 1);
-        add_deep(L, 1024, 0.02f, 2, 1);
-        add_deep(L, 1024, 0.02f, 6, 1);
-        add_deep(L, 1024, 0.01f, 0, 1);
-        add_deep(L, 1024, 0.06f, 0, 1);
-        add_deep(L, 1024, 0.1f, 0, 1);
-    }
-    if (!quick && (papers & SCENE_PAPERS_DEEP)) {
-        add_deep(L, 1024, 0.02f, 0, 5);
-        static const uint32_t small[] = {128, 256, 512};
-        for (size_t i = 0; i < 3; ++i) {
-            add_deep(L, small[i], 0.02f, 0, 5);
-            add_deep(L, small[i], 0.06f, 0, 5);
+    for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
+        const umbra__technique *tech = umbra__technique_by_id(umbra_technique_get(t)->id);
+        for (uint32_t i = 0; i < tech->sweep_count; ++i) {
+            const umbra__setting *s = &tech->sweep[i];
+            if (!in_sweep(s->flags, quick, papers))
+                continue;
+            config *c = add_config(L, tech->info.id);
+            if (!c)
+                return;
+            snprintf(c->label, sizeof c->label, "%s", s->label);
+            snprintf(c->params, sizeof c->params, "%s", s->params);
+            if (apply_params(c, s->params) != 0 ||
+                ((tech->info.flags & UMBRA_TECHNIQUE_MAP) && c->desc.map.size > max_map)) {
+                L->count--;
+                continue;
+            }
+            if (s->flags & (quick ? UMBRA__SWEEP_HEADLINE_QUICK : UMBRA__SWEEP_HEADLINE))
+                c->headline = ++L->headline_count;
         }
-    }
-    /* Convolution renders every frame slice by slice: a frame costs seconds to a minute on the
-     * CPU, so the sweep samples its parameter plane rather than covering it (the convolution
-     * bench covers the paper's Table 1 grid on a small image). */
-    if (quick) {
-        add_convolution(L, 1.0f, 0, 0);
-        add_convolution(L, 2.0f, 0, 0);
-        add_convolution(L, 2.0f, 1, 0);
-    } else {
-        add_convolution(L, 0.5f, 0, 0);
-        add_convolution(L, 1.0f, 0, 0);
-        add_convolution(L, 2.0f, 0, 0);
-        add_convolution(L, 2.0f, 1, 0);
-        add_convolution(L, 2.0f, 3, 0);
-        add_convolution(L, 1.0f, 0, 1);
-        add_convolution(L, 2.0f, 0, 1);
-        add_convolution(L, 2.0f, 3, 1);
     }
 }
 
@@ -618,8 +476,10 @@ int bench_accuracy(int argc, char **argv)
             printf("%s%s: %s (%s)\n", B.scenes[si].name, B.present[si] ? "" : " [volume absent]",
                    B.scenes[si].description, B.scenes[si].volume);
             for (int i = 0; i < L.count; ++i)
-                printf("  %-12s %-40s %s\n", umbra_shadow_technique_name(L.items[i].desc.technique),
-                       L.items[i].label, L.items[i].params);
+                printf("  %-12s %-40s %s%s\n",
+                       umbra_shadow_technique_name(L.items[i].desc.technique),
+                       L.items[i].label, L.items[i].params,
+                       L.items[i].headline ? " [headline]" : "");
         }
         if (B.present[si])
             B.run_total += L.count;

@@ -36,31 +36,24 @@
 
 /* ---- the settings swept ---------------------------------------------------------------------- */
 
-/* Rows of the headline table: one representative setting per technique. */
-enum {
-    H_NONE = 1,
-    H_EXACT,
-    H_REF_COARSE,
-    H_THRESHOLD,
-    H_CSSM,
-    H_DEEP,
-    H_DEEP3,
-    H_CONV,
-    H_COUNT
-};
+/* Rows of the headline table: none, the exact reference, then one representative setting (or
+ * two) per technique, numbered in the sweep's order from H_FIRST_TECHNIQUE (the settings flagged
+ * headline in the registry). */
+enum { H_NONE = 1, H_EXACT, H_FIRST_TECHNIQUE };
 
 typedef struct config {
     umbra_shadow_desc desc;
+    int preintegrated; /* umbra_render_desc.preintegrated for this setting */
     char label[96];   /* for people: "1024² 13 taps" */
     char params[160]; /* for the CSV: "map_size=1024;taps=13" */
-    int headline;     /* H_* or 0 */
+    int headline;     /* its row of the headline table (1.., H_NONE, H_EXACT, ...) or 0 */
     int exact;        /* the exact reference itself */
 } config;
 
 typedef struct config_list {
     config items[MAX_CONFIGS];
     int count;
-    uint32_t headline_map; /* the map size of the headline settings: 1024, or 512 with --quick */
+    int headline_count; /* the largest headline row */
 } config_list;
 
 /* ---- results --------------------------------------------------------------------------------- */

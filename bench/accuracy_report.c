@@ -165,11 +165,6 @@ void accuracy_write_csv(bench_run *B)
 
 /* ---- output: plots --------------------------------------------------------------------------- */
 
-static const umbra_shadow_technique plot_order[] = {
-    UMBRA_SHADOW_NONE, UMBRA_SHADOW_REFERENCE, UMBRA_SHADOW_THRESHOLD,
-    UMBRA_SHADOW_CSSM, UMBRA_SHADOW_DEEP, UMBRA_SHADOW_CONVOLUTION,
-};
-
 /* gnuplot single-quoted string: a quote is doubled. */
 static void gp_string(FILE *f, const char *name, const char *value)
 {
@@ -195,27 +190,29 @@ void accuracy_write_plots(bench_run *B)
          * for the memory plot only those that hold memory (the axis is logarithmic). */
         char techs[256] = "", styles[64] = "", techs_mem[256] = "", styles_mem[64] = "";
         int any = 0, any_mem = 0;
-        for (size_t t = 0; t < sizeof plot_order / sizeof plot_order[0]; ++t) {
+        /* The registry's order gives each technique its style (bench/plot_accuracy.gp). */
+        for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
+            const umbra_technique_info *ti = umbra_technique_get(t);
             int has = 0, has_mem = 0;
             for (int k = 0; k < B->result_count; ++k) {
                 const result *r = &B->results[k];
-                if (r->scene == si && r->cfg.desc.technique == plot_order[t] && !r->cfg.exact &&
+                if (r->scene == si && r->cfg.desc.technique == ti->id && !r->cfg.exact &&
                     r->err.rmse > 0.0) {
                     has = 1;
                     has_mem |= r->memory > 0;
                 }
             }
-            const char *name = umbra_shadow_technique_name(plot_order[t]);
+            const char *name = ti->name;
             if (has) {
                 size_t n = strlen(techs), m = strlen(styles);
                 snprintf(techs + n, sizeof techs - n, "%s%s", any ? " " : "", name);
-                snprintf(styles + m, sizeof styles - m, "%s%zu", any ? " " : "", t + 1);
+                snprintf(styles + m, sizeof styles - m, "%s%u", any ? " " : "", t + 1);
                 any = 1;
             }
             if (has_mem) {
                 size_t n = strlen(techs_mem), m = strlen(styles_mem);
                 snprintf(techs_mem + n, sizeof techs_mem - n, "%s%s", any_mem ? " " : "", name);
-                snprintf(styles_mem + m, sizeof styles_mem - m, "%s%zu", any_mem ? " " : "", t + 1);
+                snprintf(styles_mem + m, sizeof styles_mem - m, "%s%u", any_mem ? " " : "", t + 1);
                 any_mem = 1;
             }
         }
@@ -312,7 +309,10 @@ static void headline_table(const bench_run *B, FILE *f, int si)
                "RMSE | reference's own RMSE | SSIM | memory | speed-up over exact reference |%s\n"
                "|---|---|---|---|---|---|---|---|%s\n", si < 0 ? " scenes |" : "",
             si < 0 ? "---|" : "");
-    for (int h = H_NONE; h < H_COUNT; ++h) {
+    int rows = 0;
+    for (int k = 0; k < B->result_count; ++k)
+        rows = B->results[k].cfg.headline > rows ? B->results[k].cfg.headline : rows;
+    for (int h = H_NONE; h <= rows; ++h) {
         double lo = 0, lb = 0, rm = 0, ss = 0, lmem = 0, lsp = 0, ru = 0;
         int n = 0, nb = 0, nmem = 0, nu = 0;
         const result *any = NULL;
@@ -460,7 +460,7 @@ void accuracy_write_summary(bench_run *B)
                     fprintf(f, "The reference's own uncertainty (its step %g against half of it): "
                                "RMSE %.1e, max %.1e; column \"ref ±\" below.\n\n",
                             r->cfg.desc.technique == UMBRA_SHADOW_REFERENCE
-                                ? r->cfg.desc.reference_step
+                                ? r->cfg.desc.reference.step
                                 : accuracy_exact_step(spec),
                             r->ref_unc.rmse, r->ref_unc.max_abs);
                 else
@@ -518,14 +518,15 @@ static const result *find_run(const bench_run *B, int si, umbra_shadow_technique
     for (int k = 0; k < B->result_count; ++k) {
         const result *r = &B->results[k];
         const umbra_shadow_desc *d = &r->cfg.desc;
-        if (r->scene != si || d->technique != t || d->map_size != map)
+        if (r->scene != si || d->technique != t || d->map.size != map)
             continue;
-        if (t == UMBRA_SHADOW_THRESHOLD && (d->taps != taps || d->threshold != 0.5f))
+        if (t == UMBRA_SHADOW_THRESHOLD &&
+            (d->threshold.taps != taps || d->threshold.threshold != 0.5f))
             continue;
-        if (t == UMBRA_SHADOW_CSSM && (d->taps != taps || d->ray_block != 0))
+        if (t == UMBRA_SHADOW_CSSM && (d->cssm.taps != taps || d->cssm.ray_block != 0))
             continue;
-        if (t == UMBRA_SHADOW_DEEP &&
-            (d->epsilon != eps || d->max_nodes != nodes || d->prefilter != prefilter))
+        if (t == UMBRA_SHADOW_DEEP && (d->deep.epsilon != eps || d->deep.max_nodes != nodes ||
+                                       d->deep.prefilter != prefilter))
             continue;
         return r;
     }

@@ -149,13 +149,22 @@ typedef struct measurement {
     umbra_render_stats stats;
 } measurement;
 
+/* The scene's options with the setting's pre-integration, then the setting's shadow. */
+static umbra_status set_config(scene_ctx *S, const config *c)
+{
+    umbra_render_desc o = S->scene.options;
+    o.preintegrated = c->preintegrated;
+    umbra_status st = umbra_renderer_set_options(S->r, &o);
+    return st == UMBRA_SUCCESS ? umbra_renderer_set_shadow(S->r, &c->desc) : st;
+}
+
 /* Renders the error image into rgba (scene light), then the timed frames into scratch. */
 static outcome measure(bench_run *B, scene_ctx *S, const char *scene, const config *c,
                        float *rgba, float *scratch, measurement *m)
 {
     umbra_renderer r = S->r;
     uint32_t w = S->width, h = S->height;
-    umbra_status st = umbra_renderer_set_shadow(r, &c->desc);
+    umbra_status st = set_config(S, c);
     if (st != UMBRA_SUCCESS)
         return classify(B, st, scene, c, "umbra_renderer_set_shadow");
     if ((st = umbra_renderer_set_light(r, &S->light)) != UMBRA_SUCCESS)
@@ -225,7 +234,7 @@ static outcome reference_image(bench_run *B, scene_ctx *S, int si, const config 
     key = scene_hash_bytes(key, tag, strlen(tag));
     key = scene_hash_bytes(key, &S->width, sizeof S->width);
     key = scene_hash_bytes(key, &S->height, sizeof S->height);
-    key = scene_hash_bytes(key, &c->desc.reference_step, sizeof c->desc.reference_step);
+    key = scene_hash_bytes(key, &c->desc.reference.step, sizeof c->desc.reference.step);
     const char *dev = umbra_context_device_name(B->ctx);
     key = scene_hash_bytes(key, dev, strlen(dev));
     char exr[4096], meta[4096];
@@ -257,7 +266,7 @@ static outcome reference_image(bench_run *B, scene_ctx *S, int si, const config 
         umbra_context_take_error(B->ctx, NULL);
     }
     /* One frame: it takes seconds to minutes, and its device time is the same on every run. */
-    umbra_status st = umbra_renderer_set_shadow(S->r, &c->desc);
+    umbra_status st = set_config(S, c);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_light(S->r, &S->light);
     if (st == UMBRA_SUCCESS)
@@ -276,7 +285,7 @@ static outcome reference_image(bench_run *B, scene_ctx *S, int si, const config 
             if (f) {
                 fprintf(f, "render_ms %.6f\ndevice %s\ndate %s\nscene %s\nsize %ux%u\n"
                            "reference_step %g\n", s.render_ms, dev, B->started, spec->path,
-                        S->width, S->height, c->desc.reference_step);
+                        S->width, S->height, c->desc.reference.step);
                 fclose(f);
             }
         } else {
@@ -423,13 +432,13 @@ void accuracy_run_scene(bench_run *B, int si)
     metrics_error unc = {-1.0, 0.0, 0.0, 0.0, 0.0};
     {
         config half = L.items[0];
-        half.desc.reference_step *= 0.5f;
+        half.desc.reference.step *= 0.5f;
         double half_ms = 0.0;
         int half_cached = 0;
         if (reference_image(B, &S, si, &half, scratch, &half_ms, &half_cached) == MEASURED &&
             metrics_compare(scratch, ref, S.width, S.height, &unc) == 0)
             fprintf(stderr, "accuracy: %s: reference at step %g vs %g: RMSE %.5f, max %.4f\n",
-                    spec->name, L.items[0].desc.reference_step, half.desc.reference_step,
+                    spec->name, L.items[0].desc.reference.step, half.desc.reference.step,
                     unc.rmse, unc.max_abs);
         else
             unc.rmse = -1.0;
@@ -460,7 +469,7 @@ void accuracy_run_scene(bench_run *B, int si)
         row->slices = m.stats.slices;
         row->samples = m.stats.samples;
         row->map_size = m.stats.map_size;
-        if (c->desc.map_size == UMBRA_MAP_SIZE_AUTO && row->map_size) /* "auto size (192²)" */
+        if (c->desc.map.size == UMBRA_MAP_SIZE_AUTO && row->map_size) /* "auto size (192²)" */
             snprintf(row->cfg.label + strlen(row->cfg.label),
                      sizeof row->cfg.label - strlen(row->cfg.label), " (%u²)", row->map_size);
         row->width = S.width;

@@ -33,6 +33,8 @@ int bench_readme(int argc, char **argv);   /* bench/readme.c */
 int bench_scale(int argc, char **argv);    /* bench/scale.c */
 int bench_interactive(int argc, char **argv); /* bench/interactive.c */
 int bench_builds(int argc, char **argv);   /* bench/builds.c */
+int bench_conformance(int argc, char **argv); /* bench/conformance.c */
+int bench_progress(int argc, char **argv); /* bench/progress.c */
 
 /* ---- timing -------------------------------------------------------------------------------------- */
 

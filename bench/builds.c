@@ -3,7 +3,8 @@
  * (issue #12's "build at equal map size over the threshold build").
  *
  * For each scene (bench/scenes/walnut.scene and bonsai.scene by default) and map size (512 and
- * 1024 by default), six builds of the same light:
+ * 1024 by default), a build of the same light for each variant the registry gives (the settings
+ * of the light-space maps flagged for it, host/techniques/; today six):
  *   threshold       the opacity-threshold map at its default threshold, 0.5: the baseline;
  *   threshold-0.99  a threshold march as long as the deep map's: stopped where the deep map's
  *                   march stops (visibility below epsilon / 2 = 0.01, opacity 0.99), at the deep
@@ -32,7 +33,9 @@
 #include <string.h>
 
 #include "bench.h"
+#include "renderer_internal.h"
 #include "scene_file.h"
+#include "setting.h"
 
 #ifndef UMBRA_SOURCE_DIR
 #define UMBRA_SOURCE_DIR "."
@@ -43,22 +46,46 @@
 #define IMAGE_SIDE 32u
 #define TURN_DEGREES 1.0f
 
+/* A build the bench times: a setting of a light-space map from the registry (host/techniques/,
+ * the sweep rows flagged UMBRA__SWEEP_BUILDS) with one transmission. */
 typedef struct variant {
-    const char *name;
+    char name[64];
     umbra_shadow_technique technique;
+    const char *params;
     umbra_transmission transmission;
-    float threshold; /* threshold map only */
 } variant;
 
-enum { BASELINE = 0, MATCHED = 1, VARIANTS = 6 };
-static const variant variants[VARIANTS] = {
-    {"threshold", UMBRA_SHADOW_THRESHOLD, UMBRA_TRANSMISSION_GREY, 0.5f},
-    {"threshold-0.99", UMBRA_SHADOW_THRESHOLD, UMBRA_TRANSMISSION_GREY, 0.99f},
-    {"cssm-grey", UMBRA_SHADOW_CSSM, UMBRA_TRANSMISSION_GREY, 0.0f},
-    {"cssm-colored", UMBRA_SHADOW_CSSM, UMBRA_TRANSMISSION_COLORED, 0.0f},
-    {"deep-grey", UMBRA_SHADOW_DEEP, UMBRA_TRANSMISSION_GREY, 0.0f},
-    {"deep-colored", UMBRA_SHADOW_DEEP, UMBRA_TRANSMISSION_COLORED, 0.0f},
-};
+/* Ratios are taken over the first variant (the threshold map at 0.5) and the second (its march
+ * as long as the deep map's). */
+enum { BASELINE = 0, MATCHED = 1, MAX_VARIANTS = 32 };
+static variant variants[MAX_VARIANTS];
+static int variant_count;
+
+/* The variants from the registry, in its order: each build setting of each light-space map,
+ * grey, and coloured too for a technique that carries colour. */
+static void make_variants(void)
+{
+    variant_count = 0;
+    for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
+        const umbra__technique *tech = umbra__technique_by_id(umbra_technique_get(t)->id);
+        if (!(tech->info.flags & UMBRA_TECHNIQUE_MAP))
+            continue;
+        const int grey_only = (tech->info.flags & UMBRA_TECHNIQUE_GREY) != 0;
+        for (uint32_t i = 0; i < tech->sweep_count; ++i) {
+            if (!(tech->sweep[i].flags & UMBRA__SWEEP_BUILDS))
+                continue;
+            for (int colored = 0; colored <= !grey_only && variant_count < MAX_VARIANTS;
+                 ++colored) {
+                variant *v = &variants[variant_count++];
+                snprintf(v->name, sizeof v->name, "%s%s", tech->sweep[i].label,
+                         grey_only ? "" : colored ? "-colored" : "-grey");
+                v->technique = tech->info.id;
+                v->params = tech->sweep[i].params;
+                v->transmission = colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
+            }
+        }
+    }
+}
 
 typedef struct options {
     char scenes[256], scene_dir[1024];
@@ -167,13 +194,12 @@ static umbra_status renderer_for(umbra_context ctx, const umbra_scene *scene,
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = v->technique;
-    sd.map_size = n;
-    if (v->technique == UMBRA_SHADOW_THRESHOLD)
-        sd.threshold = v->threshold;
-    if (v->technique == UMBRA_SHADOW_THRESHOLD && v->threshold > 0.5f)
-        sd.map_step = 0.5f; /* threshold-0.99: the deep map's step, so its march is as long */
-    if (v->technique == UMBRA_SHADOW_DEEP)
-        sd.max_nodes = 3; /* epsilon stays at its default, 0.02 */
+    char msg[1024];
+    if (setting_apply(&sd, &opts.preintegrated, v->params, msg, sizeof msg) != 0) {
+        fprintf(stderr, "umbra-bench builds: %s\n", msg);
+        return UMBRA_ERROR_INVALID_ARGUMENT;
+    }
+    sd.map.size = n;
     umbra_status st = umbra_renderer_create(ctx, out);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_volume(*out, scene->volume);
@@ -195,16 +221,16 @@ static umbra_status run_size(umbra_context ctx, const options *o, const char *na
                              const umbra_scene *scene, umbra_transfer_function light_tf,
                              const float center[3], uint32_t n, row *rows)
 {
-    umbra_renderer r[VARIANTS] = {NULL};
+    umbra_renderer r[MAX_VARIANTS] = {NULL};
     const int rounds = o->warmup + o->builds;
-    double *ms = malloc((size_t)VARIANTS * (size_t)rounds * sizeof *ms);
+    double *ms = malloc((size_t)variant_count * (size_t)rounds * sizeof *ms);
     float *image = malloc((size_t)IMAGE_SIDE * IMAGE_SIDE * 4 * sizeof *image);
     umbra_status st = ms && image ? UMBRA_SUCCESS : UMBRA_ERROR_OUT_OF_MEMORY;
-    for (int v = 0; v < VARIANTS && st == UMBRA_SUCCESS; ++v)
+    for (int v = 0; v < variant_count && st == UMBRA_SUCCESS; ++v)
         st = renderer_for(ctx, scene, light_tf, &variants[v], n, &r[v]);
     for (int i = 0; i < rounds && st == UMBRA_SUCCESS; ++i) {
         const umbra_light light = turned_light(scene->light, center, (i % 2) * TURN_DEGREES);
-        for (int v = 0; v < VARIANTS && st == UMBRA_SUCCESS; ++v) {
+        for (int v = 0; v < variant_count && st == UMBRA_SUCCESS; ++v) {
             umbra_render_stats stats;
             st = umbra_renderer_set_light(r[v], &light);
             if (st == UMBRA_SUCCESS)
@@ -215,13 +241,13 @@ static umbra_status run_size(umbra_context ctx, const options *o, const char *na
                 ms[v * rounds + i] = stats.shadow_build_ms;
         }
     }
-    for (int v = 0; v < VARIANTS && st == UMBRA_SUCCESS; ++v) {
+    for (int v = 0; v < variant_count && st == UMBRA_SUCCESS; ++v) {
         snprintf(rows[v].scene, sizeof rows[v].scene, "%s", name);
         rows[v].map_size = n;
         rows[v].variant = v;
         rows[v].build = bench_timing_of(ms + v * rounds + o->warmup, o->builds);
     }
-    for (int v = 0; v < VARIANTS; ++v)
+    for (int v = 0; v < variant_count; ++v)
         umbra_renderer_release(r[v]);
     free(ms);
     free(image);
@@ -253,12 +279,12 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
     if (st == UMBRA_SUCCESS)
         st = umbra_volume_get_info(scene.volume, &info);
     for (int s = 0; s < o->nsizes && st == UMBRA_SUCCESS; ++s) {
-        if (*nrows + VARIANTS > MAX_ROWS)
+        if (*nrows + variant_count > MAX_ROWS)
             break;
         fprintf(stderr, "builds: %s, %u^2 ...\n", name, o->sizes[s]);
         st = run_size(ctx, o, name, &scene, light_tf, info.center, o->sizes[s], rows + *nrows);
         if (st == UMBRA_SUCCESS)
-            *nrows += VARIANTS;
+            *nrows += variant_count;
     }
     if (st != UMBRA_SUCCESS)
         fprintf(stderr, "umbra-bench builds: %s: %s: %s\n", name, umbra_status_to_string(st),
@@ -273,7 +299,7 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
 /* ---- the report ------------------------------------------------------------------------------ */
 
 /* Row i's median over the baseline's (or the matched threshold's) of the same scene and size:
- * rows come in groups of VARIANTS, in the order of variants[]. */
+ * rows come in groups of variant_count, in the order of variants[]. */
 static double over(const row *rows, int i, int base)
 {
     return rows[i].build.median / rows[i - rows[i].variant + base].build.median;
@@ -329,6 +355,7 @@ int bench_builds(int argc, char **argv)
     int rc = parse_options(argc, argv, &o);
     if (rc != 0)
         return rc > 0 ? 0 : 2;
+    make_variants();
     umbra_context ctx = bench_context(o.device);
     if (!ctx)
         return 1;

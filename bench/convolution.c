@@ -460,15 +460,15 @@ int bench_convolution(int argc, char **argv)
 
     /* The exact reference and the finest setting first: everything is measured against them. */
     sd.technique = UMBRA_SHADOW_REFERENCE;
-    sd.reference_step = 0.25f;
+    sd.reference.step = 0.25f;
     if (umbra_renderer_set_shadow(r, &sd) || measure(r, &o, ref, &base[0].t, &slices))
         goto done;
     snprintf(base[0].name, sizeof base[0].name, "reference");
     base[0].dz = distances[0];
     base[0].n = -1;
     sd.technique = UMBRA_SHADOW_CONVOLUTION;
-    sd.slice_distance = distances[0];
-    sd.cone_angle_degrees = o.cone;
+    sd.convolution.slice_distance = distances[0];
+    sd.convolution.cone_angle_degrees = o.cone;
     if (umbra_renderer_set_shadow(r, &sd) || measure(r, &o, finest, &base[1].t, &base[1].slices))
         goto done;
     size_t fg = 0;
@@ -523,10 +523,11 @@ int bench_convolution(int argc, char **argv)
                 q->pi = pi;
                 snprintf(q->name, sizeof q->name, "%s%s_%.1f_n%d", pi ? "pi_" : "",
                          n ? "scs" : "ics", q->dz, n);
-                sd.slice_distance = q->dz;
-                sd.subsamples = (uint32_t)n;
-                sd.preintegrated = pi;
-                if (umbra_renderer_set_shadow(r, &sd) || measure(r, &o, img, &q->t, &q->slices))
+                sd.convolution.slice_distance = q->dz;
+                sd.convolution.subsamples = (uint32_t)n;
+                rd.preintegrated = pi;
+                if (umbra_renderer_set_options(r, &rd) || umbra_renderer_set_shadow(r, &sd) ||
+                    measure(r, &o, img, &q->t, &q->slices))
                     goto done;
                 q->mae_finest = mae(img, finest, px, NULL, NULL);
                 q->fg_finest = mae(img, finest, px, mask, NULL);

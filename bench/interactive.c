@@ -88,7 +88,7 @@ static void usage(FILE *f)
             "  --warmup N       untimed frames before them (default 2)\n"
             "  --size WxH       image size (default: the scene's)\n"
             "  --scenes A,B     scene files' stems (default walnut,bonsai)\n"
-            "  --techniques A,B (default threshold,cssm,deep)\n"
+            "  --techniques A,B (default: every light-space map)\n"
             "  --sequences A,B  (default camera,light,opacity,light-draft)\n"
             "  --map-size auto|N  map size of the light-space techniques (default auto)\n"
             "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
@@ -102,7 +102,14 @@ static int parse_options(int argc, char **argv, options *o)
     o->frames = 24;
     o->warmup = 2;
     snprintf(o->scenes, sizeof o->scenes, "walnut,bonsai");
-    snprintf(o->techniques, sizeof o->techniques, "threshold,cssm,deep");
+    /* Every light-space map of the registry (threshold, cssm, deep). */
+    o->techniques[0] = '\0';
+    for (uint32_t t = 0; t < umbra_technique_count(); ++t)
+        if (umbra_technique_get(t)->flags & UMBRA_TECHNIQUE_MAP) {
+            size_t n = strlen(o->techniques);
+            snprintf(o->techniques + n, sizeof o->techniques - n, "%s%s", n ? "," : "",
+                     umbra_technique_get(t)->name);
+        }
     snprintf(o->sequences, sizeof o->sequences, "camera,light,opacity,light-draft");
     snprintf(o->scene_dir, sizeof o->scene_dir, "%s/bench/scenes", UMBRA_SOURCE_DIR);
     int frames_given = 0, warmup_given = 0;
@@ -225,8 +232,8 @@ static umbra_shadow_desc shadow_for(umbra_shadow_technique t, uint32_t map_size,
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = t;
-    sd.map_size = map_size;
-    sd.map_texels_per_voxel = k;
+    sd.map.size = map_size;
+    sd.map.texels_per_voxel = k;
     return sd;
 }
 
@@ -322,11 +329,15 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
     S.image = malloc((size_t)S.width * S.height * 4 * sizeof(float));
     if (!S.image)
         st = UMBRA_ERROR_OUT_OF_MEMORY;
-    const umbra_shadow_technique techs[3] = {UMBRA_SHADOW_THRESHOLD, UMBRA_SHADOW_CSSM,
-                                             UMBRA_SHADOW_DEEP};
+    /* The light-space maps of the registry, in its order. */
+    umbra_shadow_technique techs[32];
+    int ntechs = 0;
+    for (uint32_t t = 0; t < umbra_technique_count() && ntechs < 32; ++t)
+        if (umbra_technique_get(t)->flags & UMBRA_TECHNIQUE_MAP)
+            techs[ntechs++] = umbra_technique_get(t)->id;
     for (int shading = 1; shading >= 0 && st == UMBRA_SUCCESS; --shading) {
         S.scene.options.shading = shading;
-        for (int t = 0; t < 3 && st == UMBRA_SUCCESS; ++t) {
+        for (int t = 0; t < ntechs && st == UMBRA_SUCCESS; ++t) {
             if (!in_list(o->techniques, umbra_shadow_technique_name(techs[t])))
                 continue;
             if ((st = renderer_for(&S, techs[t], o->map_size, &S.shadowed)) == UMBRA_SUCCESS)
@@ -336,7 +347,9 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
                     continue;
                 if (q == SEQ_LIGHT_DRAFT) {
                     /* The last sequence: the renderer switches to the draft for it. */
-                    if (techs[t] == UMBRA_SHADOW_THRESHOLD || o->map_size != UMBRA_MAP_SIZE_AUTO)
+                    /* A map already at a texel per voxel (threshold) has no draft. */
+                    if (umbra_technique_find_id(techs[t])->map_texels_per_voxel <= 1.0f ||
+                        o->map_size != UMBRA_MAP_SIZE_AUTO)
                         continue;
                     const umbra_shadow_desc draft = shadow_for(techs[t], o->map_size, 1.0f);
                     if ((st = umbra_renderer_set_shadow(S.shadowed, &draft)) != UMBRA_SUCCESS)

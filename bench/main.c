@@ -18,8 +18,12 @@ static const bench_command commands[] = {
      "frames of an interactive session: camera orbit, light orbit, opacity edits, per technique"},
     {"builds", bench_builds,
      "light-space map builds at equal map size: threshold, CSSM, deep; grey and coloured"},
+    {"progress", bench_progress,
+     "how often a long reference render reports progress and how soon a cancel takes effect"},
     {"readme", bench_readme,
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
+    {"conformance", bench_conformance,
+     "every technique's errors in the conformance suite's cases beside the bounds it asserts"},
     {"scale", bench_scale,
      "time to first frame, frame times and memory against volume size (128^3 .. 1024^3 and up)"},
 };

@@ -32,9 +32,12 @@ set logscale xy
 set format y '%g'
 set format x '%g'
 
-# Marker shape and colour per style index: none, reference, threshold, cssm, deep, convolution.
-pt_of(i) = word('6 1 5 7 9 11', i) + 0
-lc_of(i) = word('#777777 #000000 #d62728 #1f77b4 #2ca02c #9467bd', i)
+# Marker shape and colour per style index, the technique registry's order: none, reference,
+# threshold, cssm, deep, convolution, and room for the techniques added after them.
+pt_of(i) = word('6 1 5 7 9 11 13 4 8 10 12 2', i) + 0
+lc_list = '#777777 #000000 #d62728 #1f77b4 #2ca02c #9467bd '. \
+          '#ff7f0e #8c564b #e377c2 #17becf #bcbd22 #7f7f7f'
+lc_of(i) = word(lc_list, i)
 sel(t) = (strcol(c_scene) eq scene && strcol(c_tech) eq t)
 
 set output out_time

@@ -524,7 +524,7 @@ static int case_setup(umbra_context ctx, const options *o, bench_volume *vol,
     cs->light = *light;
     cs->opts = *ro;
     cs->shadow = UMBRA_SHADOW_NONE;
-    cs->reference_step = sh->reference_step;
+    cs->reference_step = sh->reference.step;
     umbra_volume_info info;
     umbra_volume_get_info(vol->volume, &info);
     cs->brick_size = (int)info.brick_size;

@@ -38,14 +38,26 @@
 #define UMBRA_SOURCE_DIR "."
 #endif
 
-enum { NTECH = 4, MAX_SIZES = 5 };
-static const umbra_shadow_technique techs[NTECH] = {UMBRA_SHADOW_NONE, UMBRA_SHADOW_THRESHOLD,
-                                                    UMBRA_SHADOW_CSSM, UMBRA_SHADOW_DEEP};
+/* The techniques measured: none, then every light-space map of the registry, in its order
+ * (threshold, cssm, deep); a mask of them travels to the child as a number. */
+enum { MAX_TECH = 15, MAX_SIZES = 5 };
+static umbra_shadow_technique techs[MAX_TECH];
+static int ntech;
+
+static void make_techs(void)
+{
+    ntech = 0;
+    techs[ntech++] = UMBRA_SHADOW_NONE;
+    for (uint32_t t = 0; t < umbra_technique_count() && ntech < MAX_TECH; ++t)
+        if (umbra_technique_get(t)->flags & UMBRA_TECHNIQUE_MAP)
+            techs[ntech++] = umbra_technique_get(t)->id;
+}
 
 /* What one size measured. The child fills the fields up to peak_rss, the parent the rest. */
 typedef struct row {
     double context_ms, load_ms, first_ms, load_hwm, device_bytes, samples;
-    double frame_ms[NTECH], build_ms[NTECH], render_ms[NTECH], map_bytes[NTECH], runs[NTECH];
+    double frame_ms[MAX_TECH], build_ms[MAX_TECH], render_ms[MAX_TECH], map_bytes[MAX_TECH];
+    double runs[MAX_TECH];
     double peak_rss, gen_ms;
     uint32_t dims[3];
     char status[256];
@@ -222,7 +234,7 @@ static int child_run(const char *path, const uint32_t dims[3], umbra_scalar_type
     printf("first_ms %.3f\n", bench_now_ms() - t0);
     fflush(stdout);
 
-    for (int t = 0; t < NTECH; ++t) {
+    for (int t = 0; t < ntech; ++t) {
         if (!(techmask & (1 << t)))
             continue;
         umbra_shadow_desc sd;
@@ -303,7 +315,7 @@ static void parse_line(row *R, char *line)
             *keys[i].v = strtod(sp, NULL);
     char *dot = strchr(line, '.');
     int t = dot ? atoi(dot + 1) : -1;
-    if (!dot || t < 0 || t >= NTECH)
+    if (!dot || t < 0 || t >= ntech)
         return;
     *dot = 0;
     double *dst = strcmp(line, "frame_ms") == 0    ? R->frame_ms
@@ -394,7 +406,7 @@ static void csv_header(FILE *f)
 {
     fprintf(f, "size,nx,ny,nz,type,voxels,load_ms,first_frame_ms,time_to_first_frame_ms,"
                "context_ms,samples_none");
-    for (int t = 0; t < NTECH; ++t) {
+    for (int t = 0; t < ntech; ++t) {
         const char *s = umbra_shadow_technique_name(techs[t]);
         fprintf(f, ",%s_frame_ms,%s_build_ms,%s_render_ms,%s_map_bytes", s, s, s, s);
     }
@@ -413,7 +425,7 @@ static void csv_row(FILE *f, const row *R, umbra_scalar_type type)
         fprintf(f, ",,,,");
     if (R->samples > 0.0)
         fprintf(f, "%.0f", R->samples);
-    for (int t = 0; t < NTECH; ++t)
+    for (int t = 0; t < ntech; ++t)
         if (R->runs[t] > 0.0)
             fprintf(f, ",%.1f,%.1f,%.1f,%.0f", R->frame_ms[t], R->build_ms[t], R->render_ms[t],
                     R->map_bytes[t]);
@@ -458,8 +470,8 @@ static void write_md(FILE *f, const row *rows, int n, const options *o, const ch
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     char map[32];
-    if (sd.map_size)
-        snprintf(map, sizeof map, "%u²", sd.map_size);
+    if (sd.map.size)
+        snprintf(map, sizeof map, "%u²", sd.map.size);
     else
         snprintf(map, sizeof map, "auto");
     fprintf(f, "# umbra-bench scale\n\n- Started: %s; umbra commit %s\n- CPU: %s\n- OpenCL device: "
@@ -479,7 +491,7 @@ static void write_md(FILE *f, const row *rows, int n, const options *o, const ch
         fmt_ms(R->load_ms, c[0], 32);
         fmt_ms(R->first_ms, c[1], 32);
         fmt_ms(R->first_ms > 0.0 ? R->load_ms + R->first_ms : 0.0, c[2], 32);
-        for (int t = 0; t < NTECH; ++t)
+        for (int t = 0; t < ntech; ++t)
             fmt_ms(R->runs[t] > 0.0 ? R->frame_ms[t] : 0.0, c[3 + t], 32);
         bench_format_bytes((size_t)R->peak_rss, c[7], 32);
         char smp[32] = "–";
@@ -542,7 +554,7 @@ static void usage(FILE *f)
             "  --quick            128^3 and 256^3, --runs 1 (a minute or two)\n"
             "  --max WxHxD        add a larger size, e.g. 2048x2048x1536\n"
             "  --type T           uint8 (default), uint16, int16 or float\n"
-            "  --techniques A,B   of none,threshold,cssm,deep (default all)\n"
+            "  --techniques A,B   of none and the light-space maps (default all)\n"
             "  --size WxH         image size (default 512x512)\n"
             "  --runs N           timed frames per technique after the first (default 3)\n"
             "  --results DIR      also write DIR/scale.csv, DIR/scale.md, DIR/scale.png\n"
@@ -561,7 +573,7 @@ static int parse_techniques(const char *s, int *mask)
         umbra_shadow_technique t;
         int found = -1;
         if (umbra_shadow_technique_parse(tok, &t) == UMBRA_SUCCESS)
-            for (int k = 0; k < NTECH; ++k)
+            for (int k = 0; k < ntech; ++k)
                 found = techs[k] == t ? k : found;
         if (found < 0)
             return -1;
@@ -584,7 +596,8 @@ int bench_scale(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.runs = 3;
     o.plots = 1;
-    o.techmask = (1 << NTECH) - 1;
+    make_techs();
+    o.techmask = (1 << ntech) - 1;
     o.width = o.height = 512;
     o.type = UMBRA_UINT8;
     const char *maxdims = NULL, *tmpenv = getenv("TMPDIR");
@@ -597,7 +610,7 @@ int bench_scale(int argc, char **argv)
         umbra_scalar_type t;
         if (parse_dims(argv[3], d) != 0 || parse_type(argv[4], &t) != 0 ||
             bench_parse_size(argv[5], &w, &h) != 0 || bench_parse_int(argv[6], 1, 64, &runs) != 0 ||
-            bench_parse_int(argv[7], 1, 15, &mask) != 0)
+            bench_parse_int(argv[7], 1, (1L << ntech) - 1, &mask) != 0)
             return 2;
         return child_run(argv[2], d, t, w, h, (int)runs, (int)mask, argv[8][0] ? argv[8] : NULL);
     }

@@ -166,10 +166,11 @@ int main(int argc, char **argv)
         umbra_shadow_desc sd;
         umbra_shadow_desc_init(&sd);
         sd.technique = s->technique;
+        rd.preintegrated = 0;
         if (s->technique == UMBRA_SHADOW_CONVOLUTION) {
-            sd.slice_distance = s->slice_distance;
-            sd.subsamples = s->subsamples;
-            sd.preintegrated = s->preintegrated;
+            sd.convolution.slice_distance = s->slice_distance;
+            sd.convolution.subsamples = s->subsamples;
+            rd.preintegrated = s->preintegrated;
         }
         if (umbra_renderer_set_options(r, &rd) || umbra_renderer_set_shadow(r, &sd) ||
             umbra_renderer_render(r, w, h, img[i]) ||

@@ -11,8 +11,8 @@ int main(int argc, char **argv)
     umbra_shadow_desc shadow;
     umbra_shadow_desc_init(&shadow);
     shadow.technique = UMBRA_SHADOW_CSSM;
-    shadow.map_size = WALNUT_MAP_SIZE;
-    shadow.taps = 13;
-    shadow.seed = 1;
+    shadow.map.size = WALNUT_MAP_SIZE;
+    shadow.cssm.taps = 13;
+    shadow.cssm.seed = 1;
     return walnut_example_run(argc, argv, &shadow, "cssm.png");
 }

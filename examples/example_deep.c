@@ -13,14 +13,14 @@ int main(int argc, char **argv)
     umbra_shadow_desc shadow;
     umbra_shadow_desc_init(&shadow);
     shadow.technique = UMBRA_SHADOW_DEEP;
-    shadow.map_size = WALNUT_MAP_SIZE;
-    shadow.epsilon = 0.02f;
-    shadow.lookup_table = 1;
-    printf("== deep shadow map, epsilon %.2f, unbounded nodes\n", (double)shadow.epsilon);
+    shadow.map.size = WALNUT_MAP_SIZE;
+    shadow.deep.epsilon = 0.02f;
+    shadow.deep.lookup_table = 1;
+    printf("== deep shadow map, epsilon %.2f, unbounded nodes\n", (double)shadow.deep.epsilon);
     int rc = walnut_example_run(argc, argv, &shadow, "deep.png");
     if (rc != 0)
         return rc;
-    shadow.max_nodes = 3;
+    shadow.deep.max_nodes = 3;
     printf("== deep shadow map, 3 nodes per texel (12 values)\n");
     return walnut_example_run(argc, argv, &shadow, "deep_3nodes.png");
 }

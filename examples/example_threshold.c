@@ -12,8 +12,8 @@ int main(int argc, char **argv)
     umbra_shadow_desc shadow;
     umbra_shadow_desc_init(&shadow);
     shadow.technique = UMBRA_SHADOW_THRESHOLD;
-    shadow.map_size = WALNUT_MAP_SIZE;
-    shadow.threshold = 0.5f;
-    shadow.taps = 1;
+    shadow.map.size = WALNUT_MAP_SIZE;
+    shadow.threshold.threshold = 0.5f;
+    shadow.threshold.taps = 1;
     return walnut_example_run(argc, argv, &shadow, "threshold.png");
 }

@@ -32,6 +32,43 @@
 
 static pthread_mutex_t discovery_lock = PTHREAD_MUTEX_INITIALIZER;
 
+/* The process in which umbra first started OpenCL (0: none yet). OpenCL's state is process-wide
+ * and does not survive fork(), so this describes the process, not a context: a forked child
+ * sees its parent's pid here, and umbra_context_create refuses instead of hanging. */
+static atomic_long opencl_pid;
+
+static const char *const fork_advice =
+    "OpenCL does not work in a child made by fork() after it was started: create umbra contexts "
+    "only in the process that uses them, after any fork() (in Python, use multiprocessing's "
+    "'spawn' or 'forkserver' start method)";
+
+umbra_status umbra__check_process(umbra_context ctx, const char *fn)
+{
+    if (!ctx || ctx->pid == (long)getpid())
+        return UMBRA_SUCCESS;
+    return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                       "%s: this process (pid %ld) was forked from the one that created the "
+                       "context (pid %ld); %s", fn, (long)getpid(), ctx->pid, fork_advice);
+}
+
+int umbra__forked(umbra_context ctx) { return ctx && ctx->pid != (long)getpid(); }
+
+static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
+    UMBRA_PRINTF(3, 4);
+
+/* Records that OpenCL is in use in this process, or refuses (reporting through desc) when it
+ * was started in a parent before fork(). */
+static umbra_status claim_process(const umbra_context_desc *desc, const char *fn)
+{
+    long none = 0, self = (long)getpid();
+    if (atomic_compare_exchange_strong(&opencl_pid, &none, self) || none == self)
+        return UMBRA_SUCCESS;
+    report(desc, UMBRA_ERROR_UNSUPPORTED,
+           "%s: this process (pid %ld) was forked from one (pid %ld) that had started OpenCL; %s",
+           fn, self, none, fork_advice);
+    return UMBRA_ERROR_UNSUPPORTED;
+}
+
 struct umbra__program {
     umbra__program *next;
     char *key;          /* file names and options: what makes two programs the same */
@@ -51,8 +88,6 @@ void umbra_context_desc_init(umbra_context_desc *desc)
     desc->set_pocl_cache_dir = 1;
 }
 
-static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
-    UMBRA_PRINTF(3, 4);
 static void report(const umbra_context_desc *desc, umbra_status st, const char *fmt, ...)
 {
     if (!desc || !desc->error_callback)
@@ -222,6 +257,7 @@ static umbra_status context_alloc(const umbra_context_desc *desc, umbra_context 
     }
     atomic_init(&ctx->refs, 1);
     atomic_init(&ctx->next_id, 0);
+    ctx->pid = (long)getpid();
     if (desc) {
         ctx->callback = desc->error_callback;
         ctx->callback_user = desc->error_user;
@@ -270,9 +306,11 @@ umbra_status umbra_context_create(const umbra_context_desc *desc, umbra_context 
         return UMBRA_ERROR_INVALID_ARGUMENT;
     desc = &full;
 
-    umbra_context ctx = NULL;
-    umbra_status st = context_alloc(desc, &ctx);
+    umbra_status st = claim_process(desc, "umbra_context_create");
     if (st != UMBRA_SUCCESS)
+        return st;
+    umbra_context ctx = NULL;
+    if ((st = context_alloc(desc, &ctx)) != UMBRA_SUCCESS)
         return st;
     pthread_mutex_lock(&discovery_lock);
     prepare_pocl_cache(desc);
@@ -310,6 +348,8 @@ umbra_status umbra_context_create_from_cl(cl_context cl_ctx, cl_device_id device
     if (!desc_ok(desc, &full))
         return UMBRA_ERROR_INVALID_ARGUMENT;
     desc = &full;
+    if (claim_process(desc, "umbra_context_create_from_cl") != UMBRA_SUCCESS)
+        return UMBRA_ERROR_UNSUPPORTED;
     cl_context qctx = NULL;
     cl_device_id qdev = NULL;
     cl_command_queue_properties props = 0;
@@ -367,7 +407,7 @@ void umbra_context_retain(umbra_context ctx)
 
 void umbra_context_release(umbra_context ctx)
 {
-    if (!ctx || atomic_fetch_sub(&ctx->refs, 1) > 1)
+    if (!ctx || atomic_fetch_sub(&ctx->refs, 1) > 1 || umbra__forked(ctx))
         return;
     for (umbra__program *p = ctx->programs; p;) {
         umbra__program *next = p->next;

@@ -59,7 +59,6 @@ void umbra__frame_update_light(umbra_renderer r)
                    umbra_transfer_function_is_grey(umbra__light_tf(r)))
                       ? 1u
                       : 3u;
-    r->shadow_params.channels = r->channels;
 }
 
 void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
@@ -155,16 +154,67 @@ fail:
     return st;
 }
 
+umbra_status umbra__upload_constants(umbra_renderer r, const void *data, size_t bytes,
+                                     cl_mem *buf)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    cl_int err;
+    /* A new buffer for the same reason as umbra__upload_params. */
+    umbra__release_mem(buf);
+    *buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
+                          (void *)data, &err);
+    UMBRA_CL_CHECK(err, "clCreateBuffer(technique constants)");
+fail:
+    return st;
+}
+
 umbra_status umbra__frame_gate(umbra_renderer r)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
+    cl_event barrier = NULL;
     if (!r->async || r->async->gated)
         return UMBRA_SUCCESS;
-    if (r->async->num_wait)
+    if (r->async->num_wait) {
         UMBRA_CL(clEnqueueBarrierWithWaitList(ctx->queue, r->async->num_wait, r->async->wait_list,
-                                              NULL));
+                                              &barrier));
+        if ((st = umbra__async_hold(r, barrier, 0)) != UMBRA_SUCCESS)
+            goto fail;
+    }
     r->async->gated = 1;
+fail:
+    if (barrier)
+        clReleaseEvent(barrier);
+    return st;
+}
+
+static void CL_CALLBACK release_held(cl_event e, cl_int status, void *user)
+{
+    (void)status;
+    (void)user;
+    clReleaseEvent(e);
+}
+
+umbra_status umbra__async_hold(umbra_renderer r, cl_event e, int kernel)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    if (!r->async || !e)
+        return UMBRA_SUCCESS;
+    /* Should the callback not be set, the reference stays: an event kept is harmless. */
+    UMBRA_CL(clRetainEvent(e));
+    UMBRA_CL(clSetEventCallback(e, CL_COMPLETE, release_held, NULL));
+    if (kernel) {
+        UMBRA_CL(clRetainEvent(e));
+        if (r->async->last)
+            clReleaseEvent(r->async->last);
+        r->async->last = e;
+        if (!r->async->first) {
+            UMBRA_CL(clRetainEvent(e));
+            r->async->first = e;
+        }
+    }
 fail:
     return st;
 }

@@ -92,6 +92,7 @@ struct umbra_context_t {
     atomic_uint_least64_t next_id;      /* source of volume / transfer-function ids */
     uint64_t alloc_limit;               /* tests only (umbra__context_limit_alloc): a largest
                                            allocation below the device's, 0 for none */
+    long pid;                           /* the process that created the context (getpid) */
 };
 #endif
 
@@ -238,6 +239,19 @@ struct umbra_transfer_function_t {
  * entry of tf (up to 65536), so a jump of J between two of tf's entries is kept to within J/64. */
 umbra_status umbra__tf_for_volume(umbra_transfer_function tf, float value_min, float value_max,
                                   umbra_transfer_function *out);
+
+/* ---- processes ---------------------------------------------------------------------------- */
+
+/* OpenCL does not survive fork(): the implementation's threads (PoCL's device workers) are gone
+ * in the child, whose commands then wait forever. Every entry point that would enqueue or
+ * create OpenCL objects calls this first: UMBRA_ERROR_UNSUPPORTED, with a message naming fn and
+ * saying what to do, when the calling process is not the one that created ctx. */
+umbra_status umbra__check_process(umbra_context ctx, const char *fn);
+
+/* Nonzero in a process forked from the one that created ctx: the *_release functions then leave
+ * the object alone (its OpenCL objects belong to the parent; freeing them could touch the
+ * parent's device state), which frees nothing in the child. */
+int umbra__forked(umbra_context ctx);
 
 /* A process-wide counter would be a mutable global; ids come from the context instead. */
 uint64_t umbra__next_id(umbra_context ctx);

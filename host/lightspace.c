@@ -27,46 +27,18 @@ static void basis_from(const float w_in[3], float u[3], float v[3], float w[3])
     v[2] = w[0] * u[1] - w[1] * u[0];
 }
 
-float umbra__map_step(const umbra_shadow_desc *d, float own)
+float umbra__map_light_step(const umbra_shadow_desc *d)
 {
-    return d->map_step > 0.0f ? d->map_step : own;
+    return d->map.step > 0.0f ? d->map.step : umbra_technique_find_id(d->technique)->map_step;
 }
 
-umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_desc *d,
-                                        const char *name)
-{
-    const char *fn = "umbra_renderer_set_shadow";
-    if (d->map_size != UMBRA_MAP_SIZE_AUTO && (d->map_size < 16 || d->map_size > 8192))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_size %u must be 0 (auto) or lie in [16, 8192]", fn, name,
-                           d->map_size);
-    if (!(d->map_texels_per_voxel == 0.0f ||
-          (d->map_texels_per_voxel >= 0.25f && d->map_texels_per_voxel <= 8.0f)))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_texels_per_voxel %g must be 0 (the technique's own) or lie "
-                           "in [0.25, 8]",
-                           fn, name, d->map_texels_per_voxel);
-    if (!(d->map_step == 0.0f || (d->map_step >= 0.01f && d->map_step <= 64.0f)))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: %s map_step %g voxels must be 0 (the technique's own) or lie in "
-                           "[0.01, 64]",
-                           fn, name, d->map_step);
-    return UMBRA_SUCCESS;
-}
-
-/* Texels per voxel UMBRA_MAP_SIZE_AUTO gives each technique (include/umbra/renderer.h has the
- * rule and the measurements behind these numbers). The threshold map stores one depth per texel:
- * a texel per voxel resolves what the volume holds. CSSM's lookup averages taps fixed in texels
- * (radius 4 for 13 taps), so at one texel per voxel it blurs shadows over 4 voxels; at three its
- * error is within 5% of a 1024^2 map's on the walnut and the spheres. The deep map takes the
- * nearest texel, so its error keeps falling with the size; two texels per voxel halve the error of
- * one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
+/* Texels per voxel UMBRA_MAP_SIZE_AUTO gives the technique: the application's (a draft while the
+ * light moves), else the technique's own (its descriptor says why it chose it). */
 static double texels_per_voxel(umbra_renderer r)
 {
-    if (r->shadow.map_texels_per_voxel > 0.0f) /* the application's (a draft while it moves) */
-        return r->shadow.map_texels_per_voxel;
-    const umbra_shadow_technique t = r->tech->id;
-    return t == UMBRA_SHADOW_CSSM ? 3.0 : t == UMBRA_SHADOW_DEEP ? 2.0 : 1.0;
+    if (r->shadow.map.texels_per_voxel > 0.0f)
+        return r->shadow.map.texels_per_voxel;
+    return r->tech->info.map_texels_per_voxel;
 }
 
 /* Voxels across the map: how many voxels of the box the map's window spans as the light sees it,

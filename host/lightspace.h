@@ -18,23 +18,39 @@
  * it; infinite for a box of no extent). */
 double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
 
-/* The light step of a light-space map in voxels: desc->map_step where set, else (0, the default)
- * `own`, the technique's own step. The threshold map and CSSM take one voxel
- * (UMBRA__MAP_STEP_SURFACE), the deep map half a voxel (UMBRA__MAP_STEP_DEEP). Measured with
- * umbra-bench accuracy at auto map sizes on all seven bench scenes (issue #12): a step of 1
- * instead of 0.5 left the threshold map's RMSE at most 0.2% higher (3% lower on the spheres and
- * the foot) for builds 0.66x-0.80x, and CSSM's within 1.6% either way (its noise, not its step,
- * sets its error) for builds 0.64x-0.83x. Both find their event within a segment from the
- * segment's optical depth, so the step only sets where the volume is sampled: once a voxel, the
- * data's own spacing. The deep map's error grew 1.09x-1.24x at a step of 1 (its nodes follow the
- * sampled visibility; README), so it keeps 0.5. */
-#define UMBRA__MAP_STEP_SURFACE 1.0f
-#define UMBRA__MAP_STEP_DEEP 0.5f
-float umbra__map_step(const umbra_shadow_desc *d, float own);
+/* The light step of a light-space map in voxels: desc->map.step where set, else (0, the default)
+ * the technique's own (umbra_technique_info.map_step of desc->technique). The threshold map and
+ * CSSM take one voxel, the deep map half a voxel. Measured with umbra-bench accuracy at auto map
+ * sizes on all seven bench scenes (issue #12): a step of 1 instead of 0.5 left the threshold
+ * map's RMSE at most 0.2% higher (3% lower on the spheres and the foot) for builds 0.66x-0.80x,
+ * and CSSM's within 1.6% either way (its noise, not its step, sets its error) for builds
+ * 0.64x-0.83x. Both find their event within a segment from the segment's optical depth, so the
+ * step only sets where the volume is sampled: once a voxel, the data's own spacing. The deep
+ * map's error grew 1.09x-1.24x at a step of 1 (its nodes follow the sampled visibility; README),
+ * so it keeps 0.5. A map technique's light_step. */
+float umbra__map_light_step(const umbra_shadow_desc *d);
 
-/* The checks every light-space map makes of desc (map_size, map_texels_per_voxel, map_step), for
- * umbra_renderer_set_shadow; name is the technique's, for the message. */
-umbra_status umbra__lightspace_validate(umbra_renderer r, const umbra_shadow_desc *d,
-                                        const char *name);
+/* The shared map parameters (umbra_shadow_desc.map), the first rows of every light-space map's
+ * parameter table. */
+#define UMBRA__MAP_PARAMS                                                                      \
+    UMBRA__PARAM_KEYED(map, size, "map_size",                                                  \
+                       .doc = "map resolution, map_size^2 texels; auto chooses it from the "  \
+                              "volume's footprint as the light sees it, "                     \
+                              "map_texels_per_voxel texels per voxel",                        \
+                       .flags = UMBRA_PARAM_ZERO | UMBRA_PARAM_REBUILDS | UMBRA_PARAM_MAP,    \
+                       .default_value = UMBRA_MAP_SIZE_AUTO, .min = 16, .max = 8192,           \
+                       .zero_doc = "auto", .zero_name = "auto"),                               \
+    UMBRA__PARAM_KEYED(map, texels_per_voxel, "map_texels_per_voxel",                          \
+                       .doc = "at auto map size: texels per voxel across the box's "          \
+                              "projection; 1 is a draft while the light moves",               \
+                       .flags = UMBRA_PARAM_ZERO | UMBRA_PARAM_REBUILDS | UMBRA_PARAM_MAP,    \
+                       .default_value = 0, .min = 0.25, .max = 8,                              \
+                       .zero_doc = "the technique's own"),                                     \
+    UMBRA__PARAM_KEYED(map, step, "map_step",                                                  \
+                       .doc = "light-ray step",                                               \
+                       .unit = "voxels",                                                       \
+                       .flags = UMBRA_PARAM_ZERO | UMBRA_PARAM_REBUILDS | UMBRA_PARAM_MAP,    \
+                       .default_value = 0, .min = 0.01, .max = 64,                             \
+                       .zero_doc = "the technique's own")
 
 #endif

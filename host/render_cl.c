@@ -65,11 +65,10 @@ static umbra_status check_app_buffer(umbra_renderer r, cl_mem rgba, uint32_t wid
     return UMBRA_SUCCESS;
 }
 
-umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
-                                                cl_mem rgba)
+static umbra_status render_app_buffer(umbra_renderer r, uint32_t width, uint32_t height,
+                                      cl_mem rgba)
 {
     const char *fn = "umbra_renderer_render_to_cl_buffer";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     if ((st = umbra__check_size(r, width, height, fn)) != UMBRA_SUCCESS ||
@@ -86,13 +85,22 @@ fail:
     return st;
 }
 
-umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
-                                                      uint32_t height, cl_mem rgba,
-                                                      cl_uint num_wait, const cl_event *wait_list,
-                                                      cl_event *done)
+umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint32_t width, uint32_t height,
+                                                cl_mem rgba)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_app_buffer(r, width, height, rgba);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
+static umbra_status render_async(umbra_renderer r, uint32_t width, uint32_t height, cl_mem rgba,
+                                 cl_uint num_wait, const cl_event *wait_list, cl_event *done)
 {
     const char *fn = "umbra_renderer_render_to_cl_buffer_async";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     if (!done)
@@ -117,24 +125,57 @@ umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t
                                "%s: wait_list[%u] %p belongs to another cl_context (%p; the "
                                "renderer's is %p)", fn, i, (void *)wait_list[i], (void *)owner,
                                (void *)ctx->cl_ctx);
+        /* Commands behind an event that has already failed never run on PoCL (they wait
+         * forever): such a frame is refused before anything is enqueued. */
+        cl_int status = CL_COMPLETE;
+        if (clGetEventInfo(wait_list[i], CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status,
+                           &status, NULL) == CL_SUCCESS && status < 0)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: wait_list[%u] %p has ended in an error (execution status "
+                               "%d, %s): the frame would never run", fn, i, (void *)wait_list[i],
+                               (int)status, umbra__cl_error_name(status));
     }
-    umbra__async async = {num_wait, wait_list, 0};
+    umbra__async async = {num_wait, wait_list, 0, NULL, NULL};
     r->async = &async;
     st = umbra__render_into(r, width, height, rgba);
     r->async = NULL;
     if (st != UMBRA_SUCCESS)
-        return st;
-    if (!async.gated)
-        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                           "%s: technique '%s' enqueued its frame without the wait list's barrier",
-                           fn, umbra_shadow_technique_name(r->tech->id));
-    /* On the in-order queue, a marker completes once every command before it has. */
-    UMBRA_CL(clEnqueueMarkerWithWaitList(ctx->queue, 0, NULL, done));
+        goto fail;
+    if (!async.gated || !async.last) {
+        st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                         "%s: technique '%s' enqueued its frame without the wait list's barrier "
+                         "or without a kernel", fn, r->tech->info.name);
+        goto fail;
+    }
     UMBRA_CL(clFlush(ctx->queue));
+    /* *done is the frame's last kernel: on the in-order queue it completes after every command
+     * of the frame, and its profiling counters time that kernel (umbra_renderer_get_stats has
+     * the whole frame's). */
+    UMBRA_CL(clRetainEvent(async.last));
+    *done = async.last;
+    r->async_first = async.first;
+    r->async_last = async.last;
     return UMBRA_SUCCESS;
 fail:
-    if (*done)
-        clReleaseEvent(*done);
-    *done = NULL;
+    if (async.first)
+        clReleaseEvent(async.first);
+    if (async.last)
+        clReleaseEvent(async.last);
+    return st;
+}
+
+umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
+                                                      uint32_t height, cl_mem rgba,
+                                                      cl_uint num_wait, const cl_event *wait_list,
+                                                      cl_event *done)
+{
+    if (done)
+        *done = NULL;
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_async(r, width, height, rgba, num_wait, wait_list, done);
+        umbra__call_end(r);
+    }
     return st;
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/renderer.c: the renderer front end: validated state, what each change invalidates, and
- * the frame loop (tables -> shadow structure -> ray caster or the technique's own renderer).
+ * the frame loop (tables -> shadow structure -> ray caster or the technique's own renderer). The
+ * techniques' descriptors, their parameters and the rebuild key come from host/registry.c.
  *
  * Nothing is rebuilt per frame unless its inputs changed: step-corrected transfer-function tables
  * and brick visibility are keyed by (table id, volume id, step); the shadow structure by the full
@@ -14,50 +15,6 @@
 
 #include "preintegration.h"
 #include "renderer_internal.h"
-
-extern const umbra__technique umbra__technique_threshold; /* host/techniques/maps.c */
-extern const umbra__technique umbra__technique_cssm;      /* host/techniques/maps.c */
-extern const umbra__technique umbra__technique_deep;      /* host/techniques/deep.c */
-extern const umbra__technique umbra__technique_convolution; /* host/techniques/convolution.c */
-
-static const umbra__technique *const techniques[] = {
-    &umbra__technique_none,
-    &umbra__technique_reference,
-    &umbra__technique_threshold,
-    &umbra__technique_cssm,
-    &umbra__technique_deep,
-    &umbra__technique_convolution,
-};
-
-static const char *const technique_names[] = {"none", "reference", "threshold", "deep", "cssm",
-                                              "convolution"};
-
-const char *umbra_shadow_technique_name(umbra_shadow_technique t)
-{
-    if ((unsigned)t < sizeof technique_names / sizeof technique_names[0])
-        return technique_names[t];
-    return NULL;
-}
-
-umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out)
-{
-    if (!name || !out)
-        return UMBRA_ERROR_INVALID_ARGUMENT;
-    for (unsigned i = 0; i < sizeof technique_names / sizeof technique_names[0]; ++i)
-        if (strcmp(name, technique_names[i]) == 0) {
-            *out = (umbra_shadow_technique)i;
-            return UMBRA_SUCCESS;
-        }
-    return UMBRA_ERROR_INVALID_ARGUMENT;
-}
-
-static const umbra__technique *find_technique(umbra_shadow_technique id)
-{
-    for (size_t i = 0; i < sizeof techniques / sizeof techniques[0]; ++i)
-        if (techniques[i]->id == id)
-            return techniques[i];
-    return NULL;
-}
 
 /* ---- defaults ---------------------------------------------------------------------------------- */
 
@@ -77,32 +34,6 @@ void umbra_render_desc_init(umbra_render_desc *d)
     d->ground_color[0] = d->ground_color[1] = d->ground_color[2] = 0.8f;
     d->ground_offset = 0.02f;
     d->transmission = UMBRA_TRANSMISSION_GREY;
-}
-
-void umbra_shadow_desc_init(umbra_shadow_desc *d)
-{
-    if (!d)
-        return;
-    memset(d, 0, sizeof *d);
-    d->struct_size = sizeof *d;
-    d->technique = UMBRA_SHADOW_NONE;
-    d->reference_step = 0.25f;
-    d->map_size = UMBRA_MAP_SIZE_AUTO;
-    d->map_texels_per_voxel = 0.0f;
-    d->map_step = 0.0f; /* the technique's own (host/lightspace.h) */
-    d->threshold = 0.5f;
-    d->taps = 13;
-    d->epsilon = 0.02f;
-    d->max_nodes = 0;
-    d->block_size = 8;
-    d->prefilter = 1;
-    d->lookup_table = 1;
-    d->seed = 1;
-    d->ray_block = 0; /* as many texels per side as fit in a voxel of the map, at most 3 */
-    d->slice_distance = 0.5f;
-    d->subsamples = 0;
-    d->preintegrated = 0;
-    d->cone_angle_degrees = 5.0f;
 }
 
 /* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
@@ -155,7 +86,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
     umbra_context_retain(ctx);
     umbra_render_desc_init(&r->opts);
     umbra_shadow_desc_init(&r->shadow);
-    r->tech = &umbra__technique_none;
+    r->tech = umbra__technique_by_id(UMBRA_SHADOW_NONE);
     r->light.type = UMBRA_LIGHT_DIRECTIONAL;
     r->light.direction[0] = -0.5f;
     r->light.direction[1] = -1.0f;
@@ -181,6 +112,16 @@ static void release_kernels(umbra_renderer r)
     r->program = NULL; /* owned by the context's cache */
 }
 
+/* The last asynchronous frame's kernels, kept for its stats until the next frame. */
+static void drop_async_events(umbra_renderer r)
+{
+    if (r->async_first)
+        clReleaseEvent(r->async_first);
+    if (r->async_last)
+        clReleaseEvent(r->async_last);
+    r->async_first = r->async_last = NULL;
+}
+
 static void drop_technique(umbra_renderer r)
 {
     if (r->tech && r->tech->destroy)
@@ -189,12 +130,43 @@ static void drop_technique(umbra_renderer r)
     r->built_valid = 0;
 }
 
+umbra_status umbra__renderer_busy(umbra_renderer r, const char *fn)
+{
+    if (pthread_equal(r->busy_thread, pthread_self()))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: renderer %p is in the middle of %s on this thread: a progress "
+                           "callback must not call the renderer it reports on", fn, (void *)r,
+                           r->busy_fn);
+    return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                       "%s: renderer %p is in the middle of %s on another thread: a renderer is "
+                       "used by one thread at a time", fn, (void *)r, r->busy_fn);
+}
+
+umbra_status umbra__call_begin(umbra_renderer r, const char *fn)
+{
+    umbra_status st = umbra__check_process(r->ctx, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    r->busy_fn = fn;
+    r->busy_thread = pthread_self();
+    atomic_store(&r->busy, 1);
+    atomic_fetch_add(&r->refs, 1);
+    return UMBRA_SUCCESS;
+}
+
+void umbra__call_end(umbra_renderer r)
+{
+    atomic_store(&r->busy, 0);
+    umbra_renderer_release(r);
+}
+
 void umbra_renderer_release(umbra_renderer r)
 {
-    if (!r || atomic_fetch_sub(&r->refs, 1) > 1)
+    if (!r || atomic_fetch_sub(&r->refs, 1) > 1 || umbra__forked(r->ctx))
         return;
     drop_technique(r);
     release_kernels(r);
+    drop_async_events(r);
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
@@ -351,10 +323,13 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
     CHECK_R();
     if (!d)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", fn);
-    if (d->struct_size != sizeof *d)
+    /* umbra 0.4's layout ends before preintegrated, which such a caller sets through its shadow
+     * description (umbra_renderer_set_shadow): it keeps its value. */
+    const size_t size_0_4 = offsetof(umbra_render_desc, preintegrated);
+    if (d->struct_size != sizeof *d && d->struct_size != size_0_4)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: desc->struct_size %zu != %zu: call umbra_render_desc_init", fn,
-                           d->struct_size, sizeof *d);
+                           "%s: desc->struct_size %zu is neither %zu nor umbra 0.4's %zu: call "
+                           "umbra_render_desc_init", fn, d->struct_size, sizeof *d, size_0_4);
     if (!(d->step >= 0.01f && d->step <= 64.0f))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: step %g voxels must lie in [0.01, 64]", fn, d->step);
@@ -382,42 +357,40 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
     if (d->transmission != UMBRA_TRANSMISSION_GREY && d->transmission != UMBRA_TRANSMISSION_COLORED)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: transmission %d is unknown",
                            fn, (int)d->transmission);
-    r->opts = *d;
+    const int preintegrated = r->opts.preintegrated;
+    memcpy(&r->opts, d, d->struct_size);
+    r->opts.struct_size = sizeof r->opts;
+    if (d->struct_size == size_0_4)
+        r->opts.preintegrated = preintegrated;
     return UMBRA_SUCCESS;
 }
 
-umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *d)
+umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *desc)
 {
     const char *fn = "umbra_renderer_set_shadow";
     CHECK_R();
-    if (!d)
+    if (!desc)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", fn);
-    if (d->struct_size != sizeof *d)
+    umbra_shadow_desc d;
+    int preintegrated; /* umbra 0.4's layout carries it; -1 otherwise */
+    umbra_status st = umbra__shadow_desc_upgrade(r, desc, &d, &preintegrated, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    const umbra__technique *t = umbra__technique_by_id(d.technique);
+    if (!t)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: desc->struct_size %zu != %zu: call umbra_shadow_desc_init", fn,
-                           d->struct_size, sizeof *d);
-    const umbra__technique *t = find_technique(d->technique);
-    if (!t) {
-        const char *name = umbra_shadow_technique_name(d->technique);
-        return umbra__fail(r->ctx, name ? UMBRA_ERROR_UNSUPPORTED : UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: technique %d (%s) is not available in this build", fn,
-                           (int)d->technique, name ? name : "unknown");
-    }
-    if (!(d->reference_step >= 0.01f && d->reference_step <= 64.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: reference_step %g voxels must lie in [0.01, 64]", fn,
-                           d->reference_step);
-    if (t->validate) {
-        umbra_status st = t->validate(r, d);
-        if (st != UMBRA_SUCCESS)
-            return st;
-    }
+                           "%s: technique %d (unknown) is not in this build's registry", fn,
+                           (int)d.technique);
+    if ((st = umbra__validate_shadow(r, t, &d, fn)) != UMBRA_SUCCESS)
+        return st;
     if (t != r->tech) {
         drop_technique(r);
         release_kernels(r);
         r->tech = t;
     }
-    r->shadow = *d;
+    r->shadow = d;
+    if (preintegrated >= 0)
+        r->opts.preintegrated = preintegrated;
     return UMBRA_SUCCESS;
 }
 
@@ -447,6 +420,16 @@ double umbra__ray_samples(umbra_renderer r, float step_voxels)
     return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
 }
 
+double umbra__march_cost(umbra_renderer r, int view)
+{
+    /* The reference marches a shadow ray of up to the diagonal over its step from every view
+     * sample or query point; a map's lookup costs about as much as a sample. */
+    double shadow = 0.0;
+    if ((r->tech->info.flags & UMBRA_TECHNIQUE_SHADOW_RAYS) && r->tech->light_step)
+        shadow = umbra__ray_samples(r, r->tech->light_step(&r->shadow));
+    return view ? umbra__ray_samples(r, r->opts.step) * (1.0 + shadow) : 1.0 + shadow;
+}
+
 static umbra_status check_ray_samples(umbra_renderer r, float step_voxels, const char *what,
                                       const char *fn)
 {
@@ -466,23 +449,20 @@ static umbra_status check_ray_samples(umbra_renderer r, float step_voxels, const
 static umbra_status prepare_shadow(umbra_renderer r, double build_share)
 {
     umbra__frame_update_light(r);
-    float light_step = r->tech->light_step ? r->tech->light_step(&r->shadow) : r->shadow.reference_step;
+    const umbra__technique *t = r->tech;
+    float light_step = t->light_step ? t->light_step(&r->shadow) : 0.0f;
     umbra_status st = UMBRA_SUCCESS;
-    const char *what = r->tech->id == UMBRA_SHADOW_REFERENCE ? "shadow" : "light";
-    if (r->tech->id != UMBRA_SHADOW_NONE &&
-        (st = check_ray_samples(r, light_step, what, "umbra_renderer_render")) != UMBRA_SUCCESS)
+    if (t->light_step &&
+        (st = check_ray_samples(r, light_step, t->ray_name ? t->ray_name : "light",
+                                "umbra_renderer_render")) != UMBRA_SUCCESS)
         return st;
     st = umbra__light_tables(r);
     if (st != UMBRA_SUCCESS)
         return st;
+    /* Every frame: a parameter that does not rebuild may set the step (the reference's). */
+    r->shadow_params.step = light_step * umbra__voxel_world(r);
     umbra__light_key key;
-    memset(&key, 0, sizeof key);
-    key.volume_id = r->volume->id;
-    key.light_tf_id = umbra__light_tf(r)->id;
-    key.light = r->light;
-    key.shadow = r->shadow;
-    key.transmission = r->opts.transmission;
-    key.skip_empty = r->opts.empty_space_skipping;
+    umbra__light_key_fill(r, t, &key);
     r->stats.shadow_rebuilt = 0;
     r->stats.shadow_build_ms = 0.0;
     if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
@@ -490,10 +470,9 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
     r->built_valid = 0;
     r->stats.map_size = 0; /* set by umbra__lightspace_setup, for the light-space techniques */
     umbra__progress_phase(r, 0.0, build_share);
-    r->shadow_params.step = light_step * umbra__voxel_world(r);
     st = umbra__upload_params(r);
-    if (st == UMBRA_SUCCESS && r->tech->build)
-        st = r->tech->build(r, &r->stats.shadow_build_ms);
+    if (st == UMBRA_SUCCESS && t->build)
+        st = t->build(r, &r->stats.shadow_build_ms);
     if (st != UMBRA_SUCCESS)
         return st;
     r->built = key;
@@ -529,12 +508,13 @@ static umbra_status ensure_kernels(umbra_renderer r)
 {
     char options[256];
     /* common/lightspace.cl: the map projection the light-space techniques' lookups need. */
-    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/lightspace.cl",
-                           "common/preintegration.cl",
-                           r->tech->kernel_file, "raycast.cl"};
+    static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/lightspace.cl", "common/preintegration.cl"};
+    const char *files[16];
+    const size_t nfiles = umbra__program_files(r->tech, common, 4, "raycast.cl", files, 16);
     cl_program program;
     umbra__build_options(r, options, sizeof options);
-    umbra_status st = umbra__program_get(r->ctx, files, 6, options, &program);
+    umbra_status st = umbra__program_get(r->ctx, files, nfiles, options, &program);
     if (st != UMBRA_SUCCESS || program == r->program)
         return st;
     release_kernels(r);
@@ -568,6 +548,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_begin(r);
+    drop_async_events(r);
     /* The convolution technique's slices set its view sampling (bounded with its light step). */
     if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
         return st;
@@ -604,11 +585,11 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         goto fail;
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &out));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->samples_buf));
-    /* Pre-integrated ray casting (desc->preintegrated): the view table for the view step; any
-     * buffer stands in for it when the mode is off (table size 0). */
+    /* Pre-integrated ray casting (umbra_render_desc.preintegrated): the view table for the view
+     * step; any buffer stands in for it when the mode is off (table size 0). */
     cl_mem preint = r->view_tf_buf;
     cl_uint preint_size = 0;
-    if (r->shadow.preintegrated) {
+    if (r->opts.preintegrated) {
         st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step,
                                   UMBRA__PREINT_VIEW, 0, &preint, NULL);
         if (st != UMBRA_SUCCESS)
@@ -625,17 +606,26 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         goto fail;
     /* A fill copies its pattern at the call: nothing points into this stack frame later. */
     UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0, sizeof zero,
-                                 0, NULL, NULL));
+                                 0, NULL, &ev));
+    st = umbra__async_hold(r, ev, 0);
+    clReleaseEvent(ev);
+    ev = NULL;
+    if (st != UMBRA_SUCCESS)
+        goto fail;
     if (r->async) {
         /* An asynchronous frame is one launch, not waited for: no bands, no progress. */
-        st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev);
         r->stats.render_ms = 0.0;
         r->stats.samples = 0;
-        goto fail; /* done or failed: the caller marks the frame's end */
+        if ((st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev)) ==
+            UMBRA_SUCCESS)
+            st = umbra__async_hold(r, ev, 1);
+        goto fail; /* done or failed: the caller hands out the frame's last kernel */
     }
     double ms = 0.0;
-    st = umbra__run_2d(r, r->render_kernel, global, r->render_local,
-                       umbra__ray_samples(r, r->opts.step), &ms, fn);
+    size_t local[2] = {r->render_local[0], r->render_local[1]};
+    const double cost = umbra__march_cost(r, 1);
+    umbra__band_local(r, cost, local);
+    st = umbra__run_2d(r, r->render_kernel, global, local, cost, &ms, fn);
     if (st != UMBRA_SUCCESS)
         goto fail;
     r->stats.render_ms = ms;
@@ -658,10 +648,9 @@ umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height
     return UMBRA_SUCCESS;
 }
 
-umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
+static umbra_status render_host(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
 {
     const char *fn = "umbra_renderer_render";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     if (!rgba)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
@@ -684,11 +673,20 @@ fail:
     return st;
 }
 
-umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
-                                         float *rgb)
+umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t height, float *rgba)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_host(r, width, height, rgba);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
+static umbra_status query_shadow(umbra_renderer r, const float *points, size_t count, float *rgb)
 {
     const char *fn = "umbra_renderer_query_shadow";
-    CHECK_R();
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     cl_mem in = NULL, outb = NULL;
@@ -700,13 +698,14 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     if ((st = check_ready(r, fn)) != UMBRA_SUCCESS ||
         (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
-    if (!r->tech->kernel_file)
+    if (!r->tech->kernel_files)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique '%s' has no per-point shadow lookup", fn,
-                           umbra_shadow_technique_name(r->tech->id));
+                           r->tech->info.name);
     umbra__progress_begin(r);
-    if ((st = prepare_shadow(r, 1.0)) != UMBRA_SUCCESS)
+    if ((st = prepare_shadow(r, 0.5)) != UMBRA_SUCCESS)
         return st;
+    umbra__progress_phase(r, r->progress_last, 1.0);
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
         return st;
     /* The points are in the volume's world; the kernel takes them in its local frame. */
@@ -735,8 +734,13 @@ umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, 
     UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_uint), &n));
     if (r->tech->bind && (st = r->tech->bind(r, r->query_kernel, next)) != UMBRA_SUCCESS)
         goto fail;
-    size_t global = count;
-    if ((st = umbra__enqueue(ctx, r->query_kernel, 1, &global, NULL, NULL)) != UMBRA_SUCCESS)
+    /* In bands like a render: a shadow query of the reference marches a shadow ray per point. */
+    const size_t global[2] = {count, 1};
+    size_t group[2] = {64, 1};
+    const double cost = umbra__march_cost(r, 0);
+    double ms = 0.0;
+    umbra__band_local(r, cost, group);
+    if ((st = umbra__run_2d(r, r->query_kernel, global, group, cost, &ms, fn)) != UMBRA_SUCCESS)
         goto fail;
     UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
     umbra__progress_end(r);
@@ -747,6 +751,18 @@ fail:
     return st;
 }
 
+umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
+                                         float *rgb)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = query_shadow(r, points, count, rgb);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
 umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
 {
     CHECK_R();
@@ -754,10 +770,27 @@ umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_get_stats: out is NULL");
     *out = r->stats;
+    /* An asynchronous frame's device time, from its first kernel's start to its last kernel's
+     * end, once that has completed. */
+    cl_int status = CL_QUEUED;
+    cl_ulong a = 0, b = 0;
+    if (r->async_last && r->ctx->profiling &&
+        clGetEventInfo(r->async_last, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status,
+                       NULL) == CL_SUCCESS &&
+        status == CL_COMPLETE &&
+        clGetEventProfilingInfo(r->async_first, CL_PROFILING_COMMAND_START, sizeof a, &a, NULL) ==
+            CL_SUCCESS &&
+        clGetEventProfilingInfo(r->async_last, CL_PROFILING_COMMAND_END, sizeof b, &b, NULL) ==
+            CL_SUCCESS &&
+        b >= a) {
+        out->render_ms = (double)(b - a) * 1e-6;
+        out->render_timing = UMBRA_TIMING_DEVICE;
+    }
     out->shadow_build_timing = r->stats.shadow_rebuilt ? measured_timing(r) : UMBRA_TIMING_NONE;
-    out->light_channels = r->tech->id == UMBRA_SHADOW_NONE ? 0
-                          : r->tech->channels               ? r->tech->channels
-                                                            : r->channels;
+    const uint32_t flags = r->tech->info.flags;
+    out->light_channels = (flags & UMBRA_TECHNIQUE_NO_LIGHT) ? 0
+                          : (flags & UMBRA_TECHNIQUE_GREY)   ? 1
+                                                             : r->channels;
     out->shadow_memory_bytes = r->tech->memory ? r->tech->memory(r) : 0;
     return UMBRA_SUCCESS;
 }

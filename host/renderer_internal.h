@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/renderer_internal.h: the renderer's state and the shadow-technique interface.
  *
- * A shadow technique is a table of functions (umbra__technique) plus, for per-sample techniques,
- * a kernels/shadow_<name>.cl file compiled into the ray caster's program (the kernel side of the
- * interface is described in kernels/techniques/none.cl). To add a technique: write both, add its
- * table to the list in host/renderer.c, and its name to umbra_shadow_technique. */
+ * A shadow technique is a descriptor (umbra__technique): its public description (name, doc,
+ * flags, parameters with their defaults, ranges and docs, which the registry shows through
+ * umbra/registry.h), the kernel files compiled into the ray caster for its per-sample lookup
+ * (the kernel side of the interface is described in kernels/techniques/none.cl), and its host
+ * functions. Each technique defines umbra__technique_<name> in host/techniques/<name>.c; the
+ * registry (host/registry.c) lists them from umbra/techniques/list.h. docs/architecture.md says
+ * how to add one. */
 #ifndef UMBRA_RENDERER_INTERNAL_H
 #define UMBRA_RENDERER_INTERNAL_H
 
@@ -14,43 +17,99 @@
 #include "common/umbra_shared.h"
 
 _Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
-_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 3 * 4 + 8 * 4 + 13 * 4, "UmbraShadow layout");
+_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 4 * 4, "UmbraShadow layout");
+
+/* A parameter: what umbra/registry.h shows, and where its value lives in umbra_shadow_desc. */
+typedef struct umbra__param {
+    umbra_param_info info;
+    size_t offset;
+} umbra__param;
+
+/* The most parameters a technique may have (the rebuild key holds them; the registry's tests
+ * check every technique against it). */
+#define UMBRA__MAX_PARAMS 24
+
+/* umbra__param's type from the C field's: float, uint32_t or int (a flag). */
+#define UMBRA__PARAM_TYPE(field)                                                               \
+    _Generic((field), float: UMBRA_PARAM_FLOAT, uint32_t: UMBRA_PARAM_UINT, int: UMBRA_PARAM_BOOL)
+
+/* A parameter row of technique member `tech` (its field `field`), the rest of its
+ * umbra_param_info given as designated initializers: .doc, .default_value, .min, .max, ... The
+ * type comes from the field, the name and key are the field's; UMBRA__PARAM_KEYED gives another
+ * key (the flat name, unique among the technique's parameters). */
+#define UMBRA__PARAM_KEYED(tech, field, key_, ...)                                             \
+    {{.name = #field, .key = key_,                                                             \
+      .type = UMBRA__PARAM_TYPE(((umbra_shadow_desc *)0)->tech.field), __VA_ARGS__},           \
+     offsetof(umbra_shadow_desc, tech.field)}
+#define UMBRA__PARAM(tech, field, ...) UMBRA__PARAM_KEYED(tech, field, #field, __VA_ARGS__)
+
+/* A setting of a technique that `umbra-bench accuracy` sweeps (bench/accuracy.c). params is
+ * "key=value;..." (the technique's keys, "auto" for a zero_name, and umbra_render_desc's
+ * preintegrated), which the bench sets by name and writes as the setting's CSV field and image
+ * name: a setting keeps its name across runs, so recorded results stay comparable. */
+typedef struct umbra__setting {
+    const char *params;
+    const char *label; /* for people: "1024², 13 taps" */
+    uint32_t flags;    /* UMBRA__SWEEP_* */
+} umbra__setting;
+
+#define UMBRA__SWEEP_QUICK 1u          /* in the quick sweep (--quick) */
+#define UMBRA__SWEEP_FULL 2u           /* in the full sweep */
+#define UMBRA__SWEEP_PAPERS_CSSM 4u    /* full sweep, scenes marked `papers cssm` only */
+#define UMBRA__SWEEP_PAPERS_DEEP 8u    /* full sweep, scenes marked `papers deep` only */
+#define UMBRA__SWEEP_HEADLINE 16u      /* the technique's row(s) of the full sweep's headline */
+#define UMBRA__SWEEP_HEADLINE_QUICK 32u /* ... and of the quick sweep's */
+#define UMBRA__SWEEP_BUILDS 64u        /* a variant of `umbra-bench builds` (bench/builds.c),
+                                          named by its label: grey, and for a technique that is
+                                          not grey-only also coloured ("-grey", "-colored") */
 
 typedef struct umbra__technique {
-    umbra_shadow_technique id;
-    /* kernels/shadow_<name>.cl, compiled into the ray caster; NULL for a technique that renders
-     * the frame itself (render != NULL). */
-    const char *kernel_file;
-    /* Step, in voxels, of the light pass: the light transfer function is corrected for it. */
+    umbra_technique_info info;      /* first: umbra_technique_get returns &info */
+    const umbra__param *params;     /* info.param_count of them */
+    const umbra__setting *sweep;    /* the bench's settings, sweep_count of them */
+    uint32_t sweep_count;
+    /* The technique's kernel files (paths under kernels/, "techniques/cssm_shared.h",
+     * "techniques/cssm.cl"), NULL-terminated, compiled after kernels/common/ and before
+     * kernels/raycast.cl into the ray caster; NULL for a technique that renders the frame itself
+     * (render != NULL). */
+    const char *const *kernel_files;
+    /* Step, in voxels, of the light pass: the light transfer function is corrected for it;
+     * NULL with UMBRA_TECHNIQUE_NO_LIGHT. */
     float (*light_step)(const umbra_shadow_desc *desc);
-    /* Rejects parameters this technique cannot use (optional). */
+    /* What its light rays are called in messages ("shadow" for the reference's); NULL: "light". */
+    const char *ray_name;
+    /* Checks that the parameter table cannot express (optional); the table's ranges are checked
+     * before. */
     umbra_status (*validate)(umbra_renderer r, const umbra_shadow_desc *desc);
     /* (Re)builds the shadow structure for the renderer's current light inputs; adds device time
-     * to *ms. Called only when the light, volume, light transfer function or shadow description
-     * changed since the last build (optional). */
+     * to *ms. Called only when an input in info.rebuilt_by or a parameter flagged
+     * UMBRA_PARAM_REBUILDS changed since the last build (optional). */
     umbra_status (*build)(umbra_renderer r, double *ms);
-    /* Sets the technique's extra kernel arguments, starting at index first (optional). */
+    /* Sets the technique's extra kernel arguments (SHADOW_KERNEL_PARAMS), starting at index first
+     * (optional). Called for every render and query: what it reads of r->shadow that is not
+     * flagged UMBRA_PARAM_REBUILDS it must pass here, not at build. */
     umbra_status (*bind)(umbra_renderer r, cl_kernel k, cl_uint first);
     /* Renders the whole frame into out instead of the ray caster (optional). */
     umbra_status (*render)(umbra_renderer r, uint32_t width, uint32_t height, cl_mem out,
                            double *ms);
-    /* Light channels the technique simulates whatever the transmission: 1 for a technique that
-     * can only carry grey light (the threshold map's binary depth test); 0 means the renderer's
-     * r->channels (3 in coloured mode, 1 when the light is grey). */
-    uint32_t channels;
     /* Device bytes held by the shadow structure (optional: 0). */
     size_t (*memory)(umbra_renderer r);
     /* Frees r->tech_state (optional). */
     void (*destroy)(umbra_renderer r);
+    /* What shared machinery needs of the technique (optional): a single-layer map's
+     * umbra__map_kind (host/techniques/maps.h). */
+    const void *data;
 } umbra__technique;
 
-/* What a shadow structure depends on; a change of any field means a rebuild. */
+/* What a shadow structure depends on; a change of any field means a rebuild. The fields of
+ * inputs the technique's info.rebuilt_by leaves out stay zero, and params holds the values of
+ * its parameters flagged UMBRA_PARAM_REBUILDS, in table order. */
 typedef struct umbra__light_key {
     uint64_t volume_id, light_tf_id;
     umbra_light light;
-    umbra_shadow_desc shadow;
-    umbra_transmission transmission;
-    int skip_empty;
+    int transmission, skip_empty;
+    int technique;
+    double params[UMBRA__MAX_PARAMS];
 } umbra__light_key;
 
 /* An asynchronous frame (umbra_renderer_render_to_cl_buffer_async), set on the renderer for the
@@ -59,6 +118,8 @@ typedef struct umbra__async {
     cl_uint num_wait;
     const cl_event *wait_list;
     int gated;                               /* the wait list's barrier is enqueued */
+    cl_event first, last;                    /* the frame's first and last kernels (retained by
+                                                umbra__async_hold), or NULL */
 } umbra__async;
 
 struct umbra_renderer_t {
@@ -102,17 +163,26 @@ struct umbra_renderer_t {
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
+    cl_event async_first, async_last;        /* the last asynchronous frame's first and last
+                                                kernels (retained) until the next frame: its
+                                                device time for umbra_renderer_get_stats */
     umbra_progress_callback progress;        /* optional: umbra_renderer_set_progress */
     void *progress_user;
     double progress_lo, progress_hi;         /* the current phase's share of the call */
     double progress_last;                    /* last fraction reported (kept non-decreasing) */
     double band_samples;                     /* test knob: samples per band, 0: the default */
+    /* The render or query call in progress (umbra__call_begin): its name and thread. Any call
+     * on the renderer meanwhile, from its progress callback or another thread, is refused. */
+    atomic_int busy;
+    const char *busy_fn;
+    pthread_t busy_thread;
 };
 
-/* Samples per band of a banded launch (umbra__run_2d): about 0.1-1 s of PoCL on two cores, a
- * small fraction of a second on a GPU; bands hold at least UMBRA__BAND_MIN_ITEMS work-items so
- * a GPU stays busy. */
-#define UMBRA__BAND_SAMPLES 33554432.0
+/* Samples per band of a banded launch (umbra__run_2d, umbra__band_plan), by the caller's
+ * estimate of the samples a work-item marches; bands hold four work-groups per compute unit on
+ * a CPU, one per unit and at least UMBRA__BAND_MIN_ITEMS work-items on a GPU, so that the
+ * device stays busy. */
+#define UMBRA__BAND_SAMPLES 16777216.0
 #define UMBRA__BAND_MIN_ITEMS 16384.0
 
 /* An upper bound on the samples one ray with the given step (in voxels) takes in the volume's
@@ -132,11 +202,32 @@ umbra_status umbra__progress(umbra_renderer r, double fraction, const char *fn);
 
 /* Runs a 2D kernel over global[0] x global[1] work-items (rounded up to local, NULL: 8 x 8) and
  * waits, adding its device time to *ms. With a progress callback the range is split into bands
- * of rows, each one launch with a global offset, of about UMBRA__BAND_SAMPLES samples at
- * cost samples per work-item, one band in flight while the previous one is waited for and
- * reported; the callback can cancel between bands. The kernel must index by global id. */
+ * (umbra__band_plan), each one launch with a global offset, one band in flight while the
+ * previous one is waited for and reported; the callback can cancel between bands. cost is an
+ * upper bound on the samples one work-item marches (shadow and light rays included). The
+ * kernel must index by global id. */
 umbra_status umbra__run_2d(umbra_renderer r, cl_kernel k, const size_t global[2],
                            const size_t *local, double cost, double *ms, const char *fn);
+
+/* The band umbra__run_2d launches at a time, in work-items along x and y (tile; the whole
+ * rounded-up range without a progress callback): whole rows of work-groups of about
+ * UMBRA__BAND_SAMPLES samples (or r->band_samples) at cost samples per work-item, or, where one
+ * row of work-groups holds more, one row of them and as many columns as the budget allows; at
+ * least the work-groups host/progress.c's band_groups asks for, except under the knob. */
+void umbra__band_plan(umbra_renderer r, const size_t global[2], const size_t local[2],
+                      double cost, size_t tile[2]);
+
+/* With a progress callback on a CPU device (or under the knob), halves the work-group local
+ * (x or y, the longer first) while a band of the fewest work-groups (band_groups) would hold
+ * more than a band's samples at cost samples per work-item: a reference render at a fine shadow step
+ * marches millions of samples per pixel. For kernels that index by global id only and use no
+ * local memory (the ray caster): the image does not change. */
+void umbra__band_local(umbra_renderer r, double cost, size_t local[2]);
+
+/* An upper bound on the samples one ray cast by the renderer's kernel marches per pixel or
+ * point: the view samples, each with its shadow ray for the reference technique (view 0: a
+ * shadow query, the shadow ray alone). */
+double umbra__march_cost(umbra_renderer r, int view);
 
 /* The view transfer function in effect, over the volume's normalised range (valid once a render
  * or query has begun). */
@@ -166,10 +257,25 @@ umbra_status umbra__light_tables(umbra_renderer r);
 
 /* ---- shared between host/renderer.c, tables.c, frame.c and render_cl.c ---------------------- */
 
-/* Every public renderer call starts with this: a NULL renderer has no context to record on. */
+/* Every public renderer call starts with this: a NULL renderer has no context to record on; a
+ * renderer in the middle of a render or query (called from its progress callback, or from
+ * another thread) is refused. */
 #define CHECK_R(fn)                                                                            \
     if (!r)                                                                                    \
-        return UMBRA_ERROR_INVALID_ARGUMENT;
+        return UMBRA_ERROR_INVALID_ARGUMENT;                                                   \
+    if (atomic_load(&r->busy))                                                                 \
+        return umbra__renderer_busy(r, __func__);
+
+/* UMBRA_ERROR_INVALID_ARGUMENT for fn called on r while r->busy_fn runs, naming both and the
+ * rule broken. */
+umbra_status umbra__renderer_busy(umbra_renderer r, const char *fn);
+
+/* Starts a render or query call named fn (after CHECK_R): refuses a forked child
+ * (umbra__check_process), marks r busy and holds a reference, so that the progress callback
+ * releasing r cannot free it under the call. umbra__call_end undoes both; r may be gone after
+ * it. */
+umbra_status umbra__call_begin(umbra_renderer r, const char *fn);
+void umbra__call_end(umbra_renderer r);
 
 /* Small vector helpers (lengths in double, so 1e20 does not overflow a float square). */
 static inline double umbra__len3d(const float v[3])
@@ -227,6 +333,15 @@ umbra_status umbra__check_size(umbra_renderer r, uint32_t width, uint32_t height
  * output. Enqueues a barrier on the wait list; the in-order queue holds everything after it. */
 umbra_status umbra__frame_gate(umbra_renderer r);
 
+/* Every command an asynchronous frame enqueues after its gate passes its event here (a no-op
+ * for blocking frames; the caller keeps its own reference). PoCL 3.1 aborts the process
+ * (pocl_update_event_failed) when the failure of a wait-list event reaches a command whose
+ * event nobody holds, as happens to commands enqueued without an event: each is held until it
+ * completes (a callback then releases it). PoCL calls no callback for an event that ends in an
+ * error, so the events of a failed frame are kept, a few hundred bytes. kernel: the command is
+ * one of the frame's kernels (the first starts the frame's device time, the last is *done). */
+umbra_status umbra__async_hold(umbra_renderer r, cl_event e, int kernel);
+
 /* Copies r->frame and r->shadow_params into fresh device buffers (r->frame_buf, r->shadow_buf):
  * nothing waits on the queue, and commands already enqueued keep the constants they were
  * enqueued with. */
@@ -241,7 +356,37 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size);
  * free index through *next. */
 umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next);
 
-extern const umbra__technique umbra__technique_none;
-extern const umbra__technique umbra__technique_reference;
+/* ---- the registry (host/registry.c) ------------------------------------------------------- */
+
+/* The descriptor with that id, or NULL. */
+const umbra__technique *umbra__technique_by_id(umbra_shadow_technique id);
+
+/* The technique's own kernel files (t->kernel_files) inserted into a program's file list: the
+ * common files first, then the technique's, then `last` (may be NULL); returns the count, at most
+ * max (the caller's array). */
+size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,
+                            const char *last, const char **files, size_t max);
+
+/* Refuses, naming fn, a desc whose parameters of technique t (and the shared map's, for a map)
+ * lie outside their ranges; then t's own validate. */
+umbra_status umbra__validate_shadow(umbra_renderer r, const umbra__technique *t,
+                                    const umbra_shadow_desc *d, const char *fn);
+
+/* Fills key with what technique t's structure depends on (info.rebuilt_by and its parameters
+ * flagged UMBRA_PARAM_REBUILDS). */
+void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t, umbra__light_key *key);
+
+/* Converts a desc of an older layout (struct_size tells which) into *out, or refuses it naming
+ * fn; *preintegrated is set to the 0.4 layout's preintegrated (-1 for a newer layout, which has
+ * none). host/shadow_desc_compat.c. */
+umbra_status umbra__shadow_desc_upgrade(umbra_renderer r, const umbra_shadow_desc *d,
+                                        umbra_shadow_desc *out, int *preintegrated,
+                                        const char *fn);
+
+/* Replaces *buf with a new read-only buffer holding bytes of data (a technique's kernel
+ * constants): nothing waits on the queue, and commands already enqueued keep the buffer they
+ * were enqueued with. */
+umbra_status umbra__upload_constants(umbra_renderer r, const void *data, size_t bytes,
+                                     cl_mem *buf);
 
 #endif

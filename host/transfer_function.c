@@ -24,7 +24,11 @@ static umbra_status check_rgba(umbra_context ctx, const char *fn, const char *wh
 static umbra_status tf_make(umbra_context ctx, const char *fn, float *table, uint32_t count,
                             umbra_transfer_function *out)
 {
-    umbra_status st = UMBRA_SUCCESS;
+    umbra_status st = umbra__check_process(ctx, fn);
+    if (st != UMBRA_SUCCESS) {
+        free(table);
+        return st;
+    }
     umbra_transfer_function tf = calloc(1, sizeof *tf);
     if (!tf) {
         free(table);
@@ -226,7 +230,7 @@ void umbra_transfer_function_retain(umbra_transfer_function tf)
 
 void umbra_transfer_function_release(umbra_transfer_function tf)
 {
-    if (!tf || atomic_fetch_sub(&tf->refs, 1) > 1)
+    if (!tf || atomic_fetch_sub(&tf->refs, 1) > 1 || umbra__forked(tf->ctx))
         return;
     if (tf->buffer)
         clReleaseMemObject(tf->buffer);

@@ -558,6 +558,9 @@ umbra_status umbra_volume_create(umbra_context ctx, const umbra_volume_desc *des
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_volume_create: ctx %p, desc %p: neither may be NULL",
                            (void *)ctx, (void *)desc);
+    umbra_status st = umbra__check_process(ctx, "umbra_volume_create");
+    if (st != UMBRA_SUCCESS)
+        return st;
     return volume_create(ctx, desc, NULL, out);
 }
 
@@ -578,7 +581,9 @@ umbra_status umbra_volume_create_filled(umbra_context ctx, const umbra_volume_de
     /* validate() wants data: a stand-in until the real pointer is known. */
     umbra_volume_desc d = *desc;
     d.data = &d;
-    umbra_status st = validate(ctx, &d);
+    umbra_status st = umbra__check_process(ctx, fn);
+    if (st == UMBRA_SUCCESS)
+        st = validate(ctx, &d);
     if (st != UMBRA_SUCCESS)
         return st;
     const size_t bytes = (size_t)d.dims[0] * d.dims[1] * d.dims[2] * umbra_scalar_type_size(d.type);
@@ -687,7 +692,7 @@ void umbra_volume_retain(umbra_volume v)
 
 void umbra_volume_release(umbra_volume v)
 {
-    if (!v || atomic_fetch_sub(&v->refs, 1) > 1)
+    if (!v || atomic_fetch_sub(&v->refs, 1) > 1 || umbra__forked(v->ctx))
         return;
     for (int s = 0; s < UMBRA__MAX_SLABS; ++s)
         if (v->slabs[s])

@@ -54,6 +54,33 @@ umbra_status umbra__read_file(umbra_context ctx, const char *func, const char *p
 umbra_status umbra__file_open(umbra_context ctx, const char *func, const char *path, FILE **out,
                               size_t *size);
 
+/* At most this many data roots in umbra_volume_load_options (io.h says so). */
+#define UMBRA_DATA_ROOTS_MAX 1024
+
+/* NULL (the defaults), or options whose struct_size and data roots are well formed; else
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the field. */
+umbra_status umbra__load_options_check(umbra_context ctx, const char *func,
+                                       const umbra_volume_load_options *options);
+
+/* Opens the data file a header (header_path) names (name, as written in it) under the data-file
+ * policy (io/data_file.c): it must resolve inside the header's directory or one of options'
+ * data roots (options checked, or NULL). Gives the FILE (the caller's to fclose), its size, and
+ * in *shown the name joined to the header's directory, for messages (malloc'ed, the caller's to
+ * free). On failure nothing is left to free. */
+umbra_status umbra__data_file_open(umbra_context ctx, const char *func, const char *header_path,
+                                   const char *name, const umbra_volume_load_options *options,
+                                   char **shown, FILE **out, size_t *size);
+
+/* The readers with detached data, with options (checked, or NULL); the public loaders call them
+ * with NULL. Messages name the public reader (umbra_volume_load_nrrd, ...). */
+umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
+                                     const umbra_volume_load_options *options, umbra_volume *out);
+umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
+                                          const umbra_volume_load_options *options,
+                                          umbra_volume *out);
+umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
+                                    const umbra_volume_load_options *options, umbra_volume *out);
+
 /* Reads exactly size bytes of f (which is path) into dst, or fails naming how many came. */
 umbra_status umbra__file_read(umbra_context ctx, const char *func, const char *path, FILE *f,
                               void *dst, size_t size);
@@ -76,6 +103,30 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
                                      umbra_scalar_type type, const uint32_t dims[3],
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out);
+
+/* io/tiff.c and io/dicom.cpp: the stack readers behind umbra_volume_load_tiff and
+ * umbra_volume_load_dicom, on count files (count 1: one file; never a directory, io/series.c
+ * lists those). func names the public function in messages. */
+umbra_status umbra__volume_load_tiff(umbra_context ctx, const char *func, const char *const *paths,
+                                     size_t count, umbra_volume *out);
+umbra_status umbra__volume_load_dicom(umbra_context ctx, const char *func,
+                                      const char *const *paths, size_t count, umbra_volume *out);
+
+/* io/series.c: a directory as a TIFF stack (when it holds .tif / .tiff files) or a DICOM series;
+ * and whether a file name is a TIFF's. */
+umbra_status umbra__volume_load_directory(umbra_context ctx, const char *func, const char *dir,
+                                          umbra_volume *out);
+int umbra__is_tiff_name(const char *name);
+
+/* io/paraview.c: nonzero if the ParaView preset file path holds a preset named name (nothing is
+ * recorded anywhere: a file that is not a preset file just holds none). */
+int umbra__paraview_file_holds(const char *path, const char *name);
+
+/* io/paraview_search.c: the first file of the preset search path (see there) holding a preset
+ * named name, in a malloc'ed *found. Else UMBRA_ERROR_IO naming the directories searched; with
+ * also_file the message says name was not a file either. */
+umbra_status umbra__paraview_find(umbra_context ctx, const char *func, const char *name,
+                                  int also_file, char **found);
 
 #ifdef __cplusplus
 }

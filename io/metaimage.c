@@ -362,19 +362,6 @@ static int convert(const void *src, int t, size_t count, void *dst)
     return 1;
 }
 
-/* The data file named by the header: relative to the header's directory unless absolute. */
-static char *data_path(const char *header_path, const char *name)
-{
-    const char *slash = strrchr(header_path, '/');
-    size_t dir = (name[0] == '/' || !slash) ? 0 : (size_t)(slash - header_path) + 1;
-    char *p = malloc(dir + strlen(name) + 1);
-    if (p) {
-        memcpy(p, header_path, dir);
-        strcpy(p + dir, name);
-    }
-    return p;
-}
-
 /* What the header says, checked. */
 typedef struct met_image {
     uint32_t dims[3];
@@ -630,6 +617,13 @@ done:
 
 umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, umbra_volume *out)
 {
+    return umbra__volume_load_metaimage(ctx, path, NULL, out);
+}
+
+umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
+                                          const umbra_volume_load_options *options,
+                                          umbra_volume *out)
+{
     static const char *const func = "umbra_volume_load_metaimage";
     umbra_status st = UMBRA_SUCCESS;
     locale_t c_locale = (locale_t)0;
@@ -722,15 +716,10 @@ umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, um
         data_size = file_size;
         start = h.data_offset;
     } else {
-        dpath = data_path(path, df_name);
-        if (!dpath) {
-            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory for \"%s\"", func,
-                             path);
-            goto fail;
-        }
         fclose(f);
         f = NULL;
-        st = umbra__file_open(ctx, func, dpath, &df, &data_size);
+        /* Under the data-file policy: inside the header's directory or a data root. */
+        st = umbra__data_file_open(ctx, func, path, df_name, options, &dpath, &df, &data_size);
         if (st != UMBRA_SUCCESS) {
             goto fail;
         }

@@ -7,9 +7,9 @@
  * paths of its gzip and ZRL decoders. So umbra reads the header text itself from a regular file,
  * takes out the "data file" line (recognised with Teem's own field table), hands the rest to
  * nrrdStringRead with skipData, and then opens the data (after the header, or the one detached
- * file named relative to the header) through umbra__file_open, checks the declared size against
- * what the file can hold before allocating anything, and decodes raw, gzip (zlib), ZRL, ascii and
- * hex itself. Limits, all refused with a message naming the value and the limit:
+ * file named relative to the header, under the data-file policy of io/data_file.c) through
+ * umbra__file_open, checks the declared size against what the file can hold before allocating
+ * anything, and decodes raw, gzip (zlib), ZRL, ascii and hex itself. Limits, all refused with a message naming the value and the limit:
  *   - the header text is at most NRRD_HEADER_MAX bytes;
  *   - raw data must fill the rest of its file exactly (after any line and byte skips); hex needs
  *     two characters a byte, ascii two a value;
@@ -524,8 +524,14 @@ fail:
 
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
 {
+    return umbra__volume_load_nrrd(ctx, path, NULL, out);
+}
+
+umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
+                                     const umbra_volume_load_options *options, umbra_volume *out)
+{
     static const char *const enc_names[] = {"raw", "gzip", "zrl", "ascii", "hex"};
-    const char *func = __func__;
+    const char *func = "umbra_volume_load_nrrd";
     umbra_status st = UMBRA_SUCCESS;
     nrrd_header h;
     Nrrd *nrrd = NULL;
@@ -690,28 +696,16 @@ umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_v
         goto fail;
     }
 
-    /* 4. The data file: the header's own (after the blank line), or the named one, which must be
-     * a regular file like any other input. */
+    /* 4. The data file: the header's own (after the blank line), or the named one, under the
+     * data-file policy (inside the header's directory or a data root; a regular file like any
+     * other input). */
     if (h.data_file) {
-        const char *slash = strrchr(path, '/');
-        if (h.data_file[0] == '/' || !slash) {
-            data_name = h.data_file;
-        } else {
-            size_t dir_len = (size_t)(slash - path) + 1;
-            data_path = malloc(dir_len + strlen(h.data_file) + 1);
-            if (!data_path) {
-                st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory for \"%s\"",
-                                 func, path);
-                goto fail;
-            }
-            memcpy(data_path, path, dir_len);
-            strcpy(data_path + dir_len, h.data_file);
-            data_name = data_path;
-        }
-        st = umbra__file_open(ctx, func, data_name, &df, &data_size);
+        st = umbra__data_file_open(ctx, func, path, h.data_file, options, &data_path, &df,
+                                   &data_size);
         if (st != UMBRA_SUCCESS) {
             goto fail;
         }
+        data_name = data_path;
         pos = 0;
     } else {
         if (!h.has_blank_line) {

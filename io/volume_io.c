@@ -309,54 +309,61 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
 
 /* The raw reader behind umbra_volume_load_raw and umbra_volume_load_dat; func names the public
  * function in messages. The file is read straight into the device's buffer
- * (umbra_volume_create_filled): no host copy of the voxels. */
-static umbra_status load_raw(umbra_context ctx, const char *func, const char *path,
-                             const umbra_raw_desc *desc, umbra_volume *out)
+ * (umbra_volume_create_filled): no host copy of the voxels. f, when not NULL, is path already
+ * opened (of file_size bytes), and is closed here either way. */
+static umbra_status load_raw(umbra_context ctx, const char *func, const char *path, FILE *f,
+                             size_t file_size, const umbra_raw_desc *desc, umbra_volume *out)
 {
     umbra_status st = UMBRA_SUCCESS;
-    FILE *f = NULL;
-    size_t file_size = 0, type_size, count, data_bytes, expected;
+    size_t type_size, count, data_bytes, expected;
     int i;
 
     type_size = umbra_scalar_type_size(desc->type);
     if (type_size == 0) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: scalar type %d is unknown (expected UMBRA_UINT8, UMBRA_UINT16, "
-                           "UMBRA_INT16 or UMBRA_FLOAT32)",
-                           func, (int)desc->type);
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: scalar type %d is unknown (expected UMBRA_UINT8, UMBRA_UINT16, "
+                         "UMBRA_INT16 or UMBRA_FLOAT32)",
+                         func, (int)desc->type);
+        goto fail;
     }
     count = 1;
     for (i = 0; i < 3; ++i) {
         if (desc->dims[i] == 0) {
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: dims %u x %u x %u: every size must be > 0", func,
-                               desc->dims[0], desc->dims[1], desc->dims[2]);
+            st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                             "%s: dims %u x %u x %u: every size must be > 0", func,
+                             desc->dims[0], desc->dims[1], desc->dims[2]);
+            goto fail;
         }
         if (count > SIZE_MAX / desc->dims[i]) {
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: dims %u x %u x %u: too many voxels", func, desc->dims[0],
-                               desc->dims[1], desc->dims[2]);
+            st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                             "%s: dims %u x %u x %u: too many voxels", func, desc->dims[0],
+                             desc->dims[1], desc->dims[2]);
+            goto fail;
         }
         count *= desc->dims[i];
         if (!(desc->spacing[i] > 0.0f) || !isfinite(desc->spacing[i])) {
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: spacing %g x %g x %g: each must be finite and > 0", func,
-                               (double)desc->spacing[0], (double)desc->spacing[1],
-                               (double)desc->spacing[2]);
+            st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                             "%s: spacing %g x %g x %g: each must be finite and > 0", func,
+                             (double)desc->spacing[0], (double)desc->spacing[1],
+                             (double)desc->spacing[2]);
+            goto fail;
         }
     }
     if (count > SIZE_MAX / type_size || count * type_size > SIZE_MAX - desc->header_bytes) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: dims %u x %u x %u plus %zu header bytes: too large", func,
-                           desc->dims[0], desc->dims[1], desc->dims[2], desc->header_bytes);
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: dims %u x %u x %u plus %zu header bytes: too large", func,
+                         desc->dims[0], desc->dims[1], desc->dims[2], desc->header_bytes);
+        goto fail;
     }
     data_bytes = count * type_size;
     expected = desc->header_bytes + data_bytes;
 
     /* Check the size before reading, so a wrong header costs nothing on a large file. */
-    st = umbra__file_open(ctx, func, path, &f, &file_size);
-    if (st != UMBRA_SUCCESS) {
-        goto fail;
+    if (!f) {
+        st = umbra__file_open(ctx, func, path, &f, &file_size);
+        if (st != UMBRA_SUCCESS) {
+            goto fail;
+        }
     }
     if (file_size != expected) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
@@ -405,7 +412,7 @@ umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const um
                            "%s: desc->struct_size is %zu, expected %zu (call umbra_raw_desc_init)",
                            __func__, desc->struct_size, sizeof(umbra_raw_desc));
     }
-    return load_raw(ctx, __func__, path, desc, out);
+    return load_raw(ctx, __func__, path, NULL, 0, desc, out);
 }
 
 /* ---- Voreen .dat ------------------------------------------------------------------------ */
@@ -448,10 +455,18 @@ static int parse_numbers(const char *s, int n, int ints, uint64_t *u, float *f)
 
 umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out)
 {
+    return umbra__volume_load_dat(ctx, path, NULL, out);
+}
+
+umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
+                                    const umbra_volume_load_options *options, umbra_volume *out)
+{
+    static const char *const func = "umbra_volume_load_dat";
     umbra_status st = UMBRA_SUCCESS;
     char *text = NULL, *raw_path = NULL, *line, *next;
     void *buf = NULL;
-    size_t size = 0;
+    FILE *raw_file = NULL;
+    size_t size = 0, raw_size = 0;
     const char *object_file = NULL, *resolution = NULL, *thickness = NULL, *format = NULL;
     uint64_t res[3] = {0, 0, 0};
     umbra_raw_desc raw;
@@ -459,20 +474,20 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
     int ok, i;
 
     if (!out) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
     }
     *out = NULL;
     if (!ctx) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", func);
     }
-    st = umbra__read_file(ctx, __func__, path, &buf, &size);
+    st = umbra__read_file(ctx, func, path, &buf, &size);
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
     text = buf;
     if (memchr(text, '\0', size)) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" is not a text file (NUL byte)",
-                         __func__, path);
+                         func, path);
         goto fail;
     }
 
@@ -511,7 +526,7 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
                 st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                                  "%s: \"%s\": ObjectModel \"%.*s\" is not supported (only I, one "
                                  "scalar per voxel)",
-                                 __func__, path, QUOTE_MAX, value);
+                                 func, path, QUOTE_MAX, value);
                 goto fail;
             }
         }
@@ -526,7 +541,7 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
         for (i = 0; i < 4; ++i) {
             if (!values[i] || values[i][0] == '\0') {
                 st = umbra__fail(ctx, UMBRA_ERROR_FORMAT, "%s: \"%s\" has no value for key %s",
-                                 __func__, path, keys[i]);
+                                 func, path, keys[i]);
                 goto fail;
             }
         }
@@ -539,7 +554,7 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
     if (!ok || res[0] == 0 || res[1] == 0 || res[2] == 0 || res[0] > UINT32_MAX ||
         res[1] > UINT32_MAX || res[2] > UINT32_MAX) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
-                         "%s: \"%s\": Resolution \"%.*s\" is not three sizes > 0", __func__,
+                         "%s: \"%s\": Resolution \"%.*s\" is not three sizes > 0", func,
                          path, QUOTE_MAX, resolution);
         goto fail;
     }
@@ -554,7 +569,7 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
         !isfinite(raw.spacing[2])) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                          "%s: \"%s\": SliceThickness \"%.*s\" is not three finite numbers > 0",
-                         __func__, path, QUOTE_MAX, thickness);
+                         func, path, QUOTE_MAX, thickness);
         goto fail;
     }
     if (equal_nocase(format, strlen(format), "UCHAR")) {
@@ -569,30 +584,18 @@ umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_vo
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                          "%s: \"%s\": Format \"%.*s\" is not supported (UCHAR, USHORT, SHORT, "
                          "FLOAT)",
-                         __func__, path, QUOTE_MAX, format);
+                         func, path, QUOTE_MAX, format);
         goto fail;
     }
 
-    /* The raw file is named relative to the directory of the .dat, unless absolute. */
-    if (object_file[0] == '/' || !strrchr(path, '/')) {
-        raw_path = malloc(strlen(object_file) + 1);
-        if (raw_path) {
-            strcpy(raw_path, object_file);
-        }
-    } else {
-        size_t dir_len = (size_t)(strrchr(path, '/') - path) + 1;
-        raw_path = malloc(dir_len + strlen(object_file) + 1);
-        if (raw_path) {
-            memcpy(raw_path, path, dir_len);
-            strcpy(raw_path + dir_len, object_file);
-        }
-    }
-    if (!raw_path) {
-        st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of memory for \"%s\"",
-                         __func__, path);
+    /* The raw file is named relative to the directory of the .dat, under the data-file policy
+     * (inside that directory or a data root). */
+    st = umbra__data_file_open(ctx, func, path, object_file, options, &raw_path, &raw_file,
+                               &raw_size);
+    if (st != UMBRA_SUCCESS) {
         goto fail;
     }
-    st = load_raw(ctx, __func__, raw_path, &raw, out);
+    st = load_raw(ctx, func, raw_path, raw_file, raw_size, &raw, out);
 
 fail:
     free(raw_path);
@@ -602,9 +605,26 @@ fail:
 
 /* ---- by extension ------------------------------------------------------------------------ */
 
+/* Nonzero if path starts with DICOM's 128-byte preamble and "DICM". */
+static int has_dicom_magic(const char *path)
+{
+    unsigned char head[132];
+    FILE *f = NULL;
+    size_t size = 0;
+    int yes = 0;
+    if (umbra__file_open(NULL, __func__, path, &f, &size) != UMBRA_SUCCESS) {
+        return 0;
+    }
+    yes = size >= sizeof head && fread(head, 1, sizeof head, f) == sizeof head &&
+          memcmp(head + 128, "DICM", 4) == 0;
+    fclose(f);
+    return yes;
+}
+
 umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out)
 {
     const char *ext;
+    struct stat sb;
     if (!out) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
     }
@@ -627,9 +647,22 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
     if (equal_nocase(ext, strlen(ext), "mha") || equal_nocase(ext, strlen(ext), "mhd")) {
         return umbra_volume_load_metaimage(ctx, path, out);
     }
+    /* After the single-file formats, which refuse a directory by name as not a regular file. */
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        return umbra__volume_load_directory(ctx, __func__, path, out);
+    }
+    if (umbra__is_tiff_name(path)) {
+        return umbra_volume_load_tiff(ctx, &path, 1, out);
+    }
+    if (equal_nocase(ext, strlen(ext), "dcm") || equal_nocase(ext, strlen(ext), "dicom") ||
+        equal_nocase(ext, strlen(ext), "ima") || has_dicom_magic(path)) {
+        return umbra_volume_load_dicom(ctx, &path, 1, out);
+    }
     return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                        "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD), .nii, "
-                       ".nii.gz (NIfTI), .mha, .mhd (MetaImage) and .dat (Voreen); VTK (.vti) is "
-                       "not supported; load headerless raw files with umbra_volume_load_raw",
+                       ".nii.gz (NIfTI), .mha, .mhd (MetaImage), .dat (Voreen), .tif, .tiff (TIFF "
+                       "stacks), .dcm or a file starting with DICOM's preamble, and a directory "
+                       "(a DICOM series or TIFF stack); VTK (.vti) is not supported; load "
+                       "headerless raw files with umbra_volume_load_raw",
                        __func__, path);
 }

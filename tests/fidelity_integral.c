@@ -280,7 +280,7 @@ fid_stats fid_compare(umbra_context ctx, const fid_scene *S, const umbra_light *
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = UMBRA_SHADOW_REFERENCE;
-    sd.reference_step = step;
+    sd.reference.step = step;
     return fid_compare_shadow(ctx, S, l, &sd, pts, n, rgb_out);
 }
 

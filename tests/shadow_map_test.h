@@ -3,10 +3,6 @@
  * test_cssm.c) share, written once and run per technique:
  *  - a homogeneous slab scene (the whole box filled with one value) and points placed at texel
  *    centres of the map, for analytic comparisons;
- *  - every light that stresses the projection (axis-aligned directions both ways, grazing
- *    directions, point lights on a face, at a corner, just outside, inside empty space and inside
- *    material) gives finite factors in [0,1] in queries and images, some shadow, and exactly 1
- *    where nothing lies between point and light;
  *  - a camera move re-uses the map, a light change rebuilds it, and the reported memory is the
  *    map's size;
  *  - empty-space skipping of the light rays (the walk over the light's cell masks) changes no
@@ -46,8 +42,9 @@ static inline umbra_shadow_desc mt_shadow(umbra_shadow_technique t, uint32_t map
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = t;
-    s.map_size = map_size;
-    s.taps = taps;
+    s.map.size = map_size;
+    s.threshold.taps = taps;
+    s.cssm.taps = taps;
     return s;
 }
 
@@ -124,7 +121,7 @@ static inline void mt_check_taps_read_their_texels(umbra_context ctx,
         assert_int_equal(umbra_renderer_query_shadow(r, p, count, f), UMBRA_SUCCESS);
         double *sum = calloc(count * 3, sizeof *sum);
         assert_non_null(sum);
-        s.taps = 1;
+        s.threshold.taps = s.cssm.taps = 1;
         assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
         for (uint32_t t = 0; t < taps; ++t) {
             q = 0;
@@ -175,143 +172,6 @@ static inline double mt_mean_abs_error(const float *a, const float *b, size_t pi
     return sum / (double)pixels;
 }
 
-/* ---- lights that stress the projection ------------------------------------------------------ */
-
-/* A 32^3 volume (box [-16, 16]^3) holding a ball of radius 6 voxels centred at (7, -6, 5), with
- * a smooth edge, and a coloured transfer function that is empty at 0: the box's middle is clear
- * for 4 voxels around the origin. For each light, queries of a cloud of points in and around the
- * box and a 40x40 image must be finite and in [0,1]; points between a light and the box, and
- * points 1.5 voxels from a point light at the origin, must be exactly lit (nothing lies between
- * them and the light). */
-static inline void mt_check_stress_lights(umbra_context ctx, umbra_shadow_desc shadow)
-{
-    enum { N = 32 };
-    const float h = 0.5f * N, ball[3] = {7.0f, -6.0f, 5.0f};
-    float *data = malloc((size_t)N * N * N * sizeof *data);
-    assert_non_null(data);
-    for (int z = 0; z < N; ++z)
-        for (int y = 0; y < N; ++y)
-            for (int x = 0; x < N; ++x) {
-                float dx = x + 0.5f - h - ball[0], dy = y + 0.5f - h - ball[1];
-                float dz = z + 0.5f - h - ball[2];
-                float d = sqrtf(dx * dx + dy * dy + dz * dz) - 6.0f;
-                data[(z * N + y) * N + x] = fminf(1.0f, fmaxf(0.0f, 0.5f - d));
-            }
-    umbra_volume_desc vd;
-    umbra_volume_desc_init(&vd);
-    vd.data = data;
-    vd.type = UMBRA_FLOAT32;
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
-    vd.value_range_given = 1;
-    vd.value_min = 0.0f;
-    vd.value_max = 1.0f;
-    umbra_volume vol = NULL;
-    assert_int_equal(umbra_volume_create(ctx, &vd, &vol), UMBRA_SUCCESS);
-    free(data);
-    const float rgba[8] = {0, 0, 0, 0, 0.9f, 0.4f, 0.1f, 0.3f};
-    umbra_transfer_function tf = NULL;
-    assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
-    const float cam_dir[3] = {0.6f, 0.45f, 1.0f};
-    umbra_camera camera = umbra_camera_orbit(cam_dir, 1.74f * N, 30.0f);
-    umbra_render_desc o;
-    umbra_render_desc_init(&o);
-    o.transmission = UMBRA_TRANSMISSION_COLORED;
-    o.ground_plane = 1;
-    struct {
-        umbra_light light;
-        const char *what;
-    } cases[] = {
-        {test_directional_light(0, -1, 0), "down the y axis"},
-        {test_directional_light(0, 1, 0), "up the y axis"},
-        {test_directional_light(1, 0, 0), "along +x"},
-        {test_directional_light(0, 0, -1), "along -z"},
-        {test_directional_light(1, -1e-3f, 0), "grazing, 0.06 degrees"},
-        {test_directional_light(0.3f, 1e-6f, -1), "grazing, 6e-5 degrees"},
-        {test_point_light(0, h, 0), "point on the top face"},
-        {test_point_light(-h, -h, h), "point on a corner"},
-        {test_point_light(h + 0.01f, 3, -2), "point just outside a face"},
-        {test_point_light(0, 0, 0), "point inside, centre"},
-        {test_point_light(5, -4, 3), "point inside the ball"},
-    };
-    enum { CLOUD = 7 * 7 * 7, W = 40, H = 40 };
-    float *pts = malloc(CLOUD * 3 * sizeof *pts), *rgb = malloc(CLOUD * 3 * sizeof *rgb);
-    float *img = malloc(W * H * 4 * sizeof *img);
-    assert_non_null(pts);
-    assert_non_null(rgb);
-    assert_non_null(img);
-    for (int i = 0; i < CLOUD; ++i) {
-        pts[3 * i + 0] = -1.4f * h + 2.8f * h * (float)(i % 7) / 6.0f;
-        pts[3 * i + 1] = -1.4f * h + 2.8f * h * (float)(i / 7 % 7) / 6.0f;
-        pts[3 * i + 2] = -1.4f * h + 2.8f * h * (float)(i / 49) / 6.0f;
-    }
-    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
-        const umbra_light *l = &cases[c].light;
-        umbra_renderer r = test_renderer_transmission(ctx, vol, tf, *l, UMBRA_TRANSMISSION_COLORED);
-        assert_int_equal(umbra_renderer_set_options(r, &o), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_camera(r, &camera), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_query_shadow(r, pts, CLOUD, rgb), UMBRA_SUCCESS);
-        if (!mt_finite_unit(rgb, CLOUD * 3))
-            fail_msg("%s: a shadow factor is not finite or outside [0,1]", cases[c].what);
-        float fmin = 1.0f;
-        for (size_t i = 0; i < CLOUD * 3; ++i)
-            fmin = fminf(fmin, rgb[i]);
-        if (!(fmin < 0.9f)) /* the ball shadows some of the cloud */
-            fail_msg("%s: no point of the cloud is shadowed (min factor %g)", cases[c].what, fmin);
-        assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
-        for (size_t i = 0; i < (size_t)W * H * 4; ++i)
-            if (!isfinite(img[i]) || img[i] < 0.0f)
-                fail_msg("%s: pixel value %g at %zu", cases[c].what, img[i], i / 4);
-
-        /* Points with nothing between them and the light. */
-        float lit[6 * 3];
-        size_t nlit = 0;
-        if (l->type == UMBRA_LIGHT_DIRECTIONAL) {
-            float dl = sqrtf(l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] +
-                             l->direction[2] * l->direction[2]);
-            /* Upwind of the box by 2 box diagonals, at a few lateral offsets. */
-            for (int k = 0; k < 3; ++k)
-                for (int a = 0; a < 3; ++a)
-                    lit[3 * k + a] = -l->direction[a] / dl * 4.0f * 1.74f * h + (k - 1) * 3.0f;
-            nlit = 3;
-        } else {
-            const float *P = l->position;
-            int inside = fabsf(P[0]) < h && fabsf(P[1]) < h && fabsf(P[2]) < h;
-            /* At the clear middle: points around it; outside the box: points farther out. */
-            if (inside && fabsf(P[0]) + fabsf(P[1]) + fabsf(P[2]) < 1.0f) {
-                const float off[6][3] = {{1.5f, 0, 0}, {-1.5f, 0, 0}, {0, 1.5f, 0},
-                                         {0, -1.5f, 0}, {0, 0, 1.5f}, {0, 0, -1.5f}};
-                for (int k = 0; k < 6; ++k)
-                    for (int a = 0; a < 3; ++a)
-                        lit[3 * k + a] = P[a] + off[k][a];
-                nlit = 6;
-            } else if (!inside) {
-                for (int a = 0; a < 3; ++a) {
-                    float out = P[a] > 0.0f ? 1.0f : -1.0f;
-                    lit[a] = P[a] + (fabsf(P[a]) >= h - 0.01f ? out * 2.0f : 0.0f);
-                    lit[3 + a] = P[a] * 1.8f + (a == 1 ? 1.0f : 0.0f);
-                }
-                nlit = 2;
-            }
-        }
-        if (nlit) {
-            float f[6 * 3];
-            assert_int_equal(umbra_renderer_query_shadow(r, lit, nlit, f), UMBRA_SUCCESS);
-            for (size_t i = 0; i < nlit * 3; ++i)
-                if (f[i] != 1.0f)
-                    fail_msg("%s: point %zu (%g, %g, %g) has nothing between it and the light "
-                             "but factor %g", cases[c].what, i / 3, lit[i / 3 * 3],
-                             lit[i / 3 * 3 + 1], lit[i / 3 * 3 + 2], f[i]);
-        }
-        umbra_renderer_release(r);
-    }
-    free(pts);
-    free(rgb);
-    free(img);
-    umbra_transfer_function_release(tf);
-    umbra_volume_release(vol);
-}
-
 /* ---- empty-space skipping -------------------------------------------------------------------- */
 
 /* The spheres at 64x64 with skipping off and on, for the scene's light and a point light above
@@ -360,7 +220,7 @@ static inline void mt_check_reuse_and_memory(umbra_context ctx, umbra_shadow_des
     enum { W = 32, H = 32 };
     float img[W * H * 4];
     umbra_render_stats st;
-    const size_t texels = (size_t)shadow.map_size * shadow.map_size;
+    const size_t texels = (size_t)shadow.map.size * shadow.map.size;
     assert_int_equal(umbra_renderer_set_shadow(r, &shadow), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_render(r, W, H, img), UMBRA_SUCCESS);
     assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);

@@ -44,7 +44,7 @@ static umbra_status render_scene(umbra_context ctx, umbra_shadow_technique techn
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = technique;
-    s.map_size = 64;
+    s.map.size = 64;
     umbra_status st = umbra_volume_create(ctx, &d, &v);
     if (!st)
         st = umbra_transfer_function_create(ctx, table, 2, &tf);

@@ -7,8 +7,9 @@
  *    per-point queries);
  *  - a cl_mem that is not a writable buffer of the context, or too small, is refused with a
  *    message naming it;
- *  - the asynchronous render waits for the application's events, hands back a completion event,
- *    keeps what it needs alive after everything is released, and equals the blocking render;
+ *  - the asynchronous render waits for the application's events, hands back a completion event
+ *    (its last kernel, timed; the stats time the frame once it has run), keeps what it needs
+ *    alive after everything is released, and equals the blocking render;
  *  - the statistics say whether their times are device or wall-clock times;
  *  - the process-wide state umbra touches (POCL_CACHE_DIR, UMBRA_DEVICE) can be left alone, and a
  *    context description of the previous, shorter layout is still accepted.
@@ -135,14 +136,14 @@ static umbra_renderer case_renderer(umbra_context ctx, const tech_case *tc, umbr
     o.shading = 1;
     o.jitter = 1;
     o.transmission = UMBRA_TRANSMISSION_COLORED;
+    o.preintegrated = tc->preintegrated;
     umbra_renderer r = test_renderer(ctx, sc->volume, sc->tf, &sc->camera, &light, &o);
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = tc->technique;
-    s.preintegrated = tc->preintegrated;
-    s.subsamples = tc->subsamples;
-    s.map_size = 128;
-    s.reference_step = 0.5f;
+    s.convolution.subsamples = tc->subsamples;
+    s.map.size = 128;
+    s.reference.step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     return r;
 }
@@ -543,6 +544,63 @@ static void test_async_frame_survives_release_of_everything(void **state)
     free(got);
 }
 
+/* What *done carries: it is the frame's last kernel (the ray caster's, or the convolution
+ * technique's resolve), so its profiling counters time that kernel, not a marker's instant; the
+ * stats, untimed while the frame is queued, give the frame's device time once it has completed:
+ * for a one-kernel frame exactly done's, for the convolution's slices and resolve more. */
+static void test_async_done_is_the_last_kernel_and_stats_time_the_frame(void **state)
+{
+    umbra_context ctx = *state;
+    const size_t n = (size_t)W * H * 4;
+    cl_int err;
+    cl_mem buf = clCreateBuffer(umbra_context_cl_context(ctx), CL_MEM_READ_WRITE,
+                                n * sizeof(float), NULL, &err);
+    assert_int_equal(err, CL_SUCCESS);
+    const tech_case *tcs[2] = {&cases[1], &cases[6]}; /* reference (ray caster), convolution */
+    alarm(120);
+    for (int t = 0; t < 2; ++t) {
+        umbra_scene sc;
+        umbra_renderer r = case_renderer(ctx, tcs[t], &sc);
+        cl_event user = clCreateUserEvent(umbra_context_cl_context(ctx), &err), done = NULL;
+        assert_int_equal(err, CL_SUCCESS);
+        assert_int_equal(umbra_renderer_render_to_cl_buffer_async(r, W, H, buf, 1, &user, &done),
+                         UMBRA_SUCCESS);
+        cl_command_type type = 0;
+        assert_int_equal(clGetEventInfo(done, CL_EVENT_COMMAND_TYPE, sizeof type, &type, NULL),
+                         CL_SUCCESS);
+        assert_int_equal(type, CL_COMMAND_NDRANGE_KERNEL);
+        umbra_render_stats st;
+        assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+        assert_int_equal(st.render_timing, UMBRA_TIMING_NONE); /* queued: not timed yet */
+        assert_true(st.render_ms == 0.0);
+        assert_int_equal(clSetUserEventStatus(user, CL_COMPLETE), CL_SUCCESS);
+        assert_int_equal(clWaitForEvents(1, &done), CL_SUCCESS);
+        cl_ulong a = 0, b = 0;
+        assert_int_equal(clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_START, sizeof a, &a,
+                                                 NULL),
+                         CL_SUCCESS);
+        assert_int_equal(clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof b, &b,
+                                                 NULL),
+                         CL_SUCCESS);
+        const double kernel_ms = (double)(b - a) * 1e-6;
+        assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+        print_message("  %s: done times %.3f ms, the stats %.3f ms\n", tcs[t]->label, kernel_ms,
+                      st.render_ms);
+        assert_int_equal(st.render_timing, UMBRA_TIMING_DEVICE);
+        assert_true(kernel_ms > 0.0);
+        if (t == 0)
+            assert_true(st.render_ms == kernel_ms);
+        else
+            assert_true(st.render_ms > kernel_ms);
+        clReleaseEvent(done);
+        clReleaseEvent(user);
+        umbra_renderer_release(r);
+        umbra_scene_release(&sc);
+    }
+    alarm(0);
+    clReleaseMemObject(buf);
+}
+
 static void test_async_bad_arguments_refused(void **state)
 {
     app_cl app, other;
@@ -796,6 +854,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_async_render_waits_for_user_event_and_equals_blocking),
         cmocka_unit_test(test_async_frames_pipeline_without_waiting),
         cmocka_unit_test(test_async_frame_survives_release_of_everything),
+        cmocka_unit_test(test_async_done_is_the_last_kernel_and_stats_time_the_frame),
         cmocka_unit_test(test_async_bad_arguments_refused),
         cmocka_unit_test(test_stats_say_device_or_wall_time),
         cmocka_unit_test(test_set_pocl_cache_dir_off_leaves_environment),

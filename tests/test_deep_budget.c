@@ -118,10 +118,10 @@ static umbra_shadow_desc deep_budget(uint32_t max_nodes)
     umbra_shadow_desc d;
     umbra_shadow_desc_init(&d);
     d.technique = UMBRA_SHADOW_DEEP;
-    d.map_size = 128;
-    d.map_step = 0.5f;
-    d.epsilon = 0.02f;
-    d.max_nodes = max_nodes;
+    d.map.size = 128;
+    d.map.step = 0.5f;
+    d.deep.epsilon = 0.02f;
+    d.deep.max_nodes = max_nodes;
     return d;
 }
 
@@ -158,7 +158,7 @@ static double check_functions(umbra_renderer r, const float *end, double *rise)
 {
     umbra__deep_info info;
     assert_int_equal(umbra__deep_get_info(r, &info), UMBRA_SUCCESS);
-    const uint32_t n = r->shadow.map_size, N = info.max_nodes, c = info.channels, f = 1 + c;
+    const uint32_t n = r->shadow.map.size, N = info.max_nodes, c = info.channels, f = 1 + c;
     assert_true(N >= 2);
     float *nodes = malloc((size_t)n * n * N * f * sizeof *nodes);
     assert_non_null(nodes);
@@ -189,7 +189,7 @@ static float *end_values(umbra_renderer r)
 {
     umbra__deep_info info;
     assert_int_equal(umbra__deep_get_info(r, &info), UMBRA_SUCCESS);
-    const uint32_t n = r->shadow.map_size, N = info.max_nodes, c = info.channels, f = 1 + c;
+    const uint32_t n = r->shadow.map.size, N = info.max_nodes, c = info.channels, f = 1 + c;
     float *nodes = malloc((size_t)n * n * N * f * sizeof *nodes);
     float *end = malloc((size_t)n * n * c * sizeof *end);
     assert_true(nodes && end);
@@ -344,7 +344,7 @@ static void test_thin_board_edge_aliasing_shrinks_with_map_size(void **state)
     double worst[3];
     for (int c = 0; c < 3; ++c) {
         d = deep_budget(0);
-        d.map_size = sizes[c];
+        d.map.size = sizes[c];
         render(r, &d, img);
         double frac, e = image_rmse(img, ref, &frac);
         worst[c] = 0.0;

@@ -63,7 +63,7 @@ static void render_with(umbra_context ctx, umbra_renderer r, umbra_shadow_techni
     umbra_shadow_desc d;
     umbra_shadow_desc_init(&d);
     d.technique = t;
-    d.max_nodes = max_nodes;
+    d.deep.max_nodes = max_nodes;
     assert_int_equal(umbra_renderer_set_shadow(r, &d), UMBRA_SUCCESS);
     if (umbra_renderer_render(r, HEAD_W, HEAD_W, img) != UMBRA_SUCCESS)
         fail_msg("render: %s", umbra_context_last_message(ctx));
@@ -200,7 +200,7 @@ static void check_axis_box(umbra_context ctx, int nx, int ny, int nz, const char
             umbra_shadow_desc sd;
             umbra_shadow_desc_init(&sd);
             sd.technique = UMBRA_SHADOW_DEEP;
-            sd.epsilon = 0.005f;
+            sd.deep.epsilon = 0.005f;
             const fid_stats deep = fid_compare_shadow(ctx, &S, &l, &sd, pts, n, NULL);
             const fid_stats ref = fid_compare(ctx, &S, &l, 0.25f, pts, n, NULL);
             const float *w = pts + 3 * deep.worst_point;

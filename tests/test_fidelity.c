@@ -425,7 +425,7 @@ static void test_fidelity_whole_steps_up_to_rounding(void **state)
         umbra_shadow_desc sd;
         umbra_shadow_desc_init(&sd);
         sd.technique = UMBRA_SHADOW_REFERENCE;
-        sd.reference_step = h;
+        sd.reference.step = h;
         assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_query_shadow(r, pts, (size_t)n_pts, rgb), UMBRA_SUCCESS);
         for (int i = 0; i < n_pts; ++i) {

@@ -116,9 +116,9 @@ static void refuse_light_step(umbra_context ctx, umbra_shadow_technique techniqu
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = technique;
-    s.reference_step = 0.01f;
-    s.map_step = 0.01f;
-    s.map_size = 16;
+    s.reference.step = 0.01f;
+    s.map.step = 0.01f;
+    s.map.size = 16;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
     float *rgba = malloc(sizeof(float) * 4 * W * H);
     assert_non_null(rgba);

@@ -102,7 +102,7 @@ static void set_reference(umbra_renderer r, float step_voxels)
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = UMBRA_SHADOW_REFERENCE;
-    s.reference_step = step_voxels;
+    s.reference.step = step_voxels;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
 }
 
@@ -328,7 +328,7 @@ static void fill_cpu_scene(cpu_scene *cs, umbra_volume vol, const float *voxels,
     cs->light = *light;
     cs->opts = *opts;
     cs->shadow = shadow->technique;
-    cs->reference_step = shadow->reference_step;
+    cs->reference_step = shadow->reference.step;
     cs->brick_size = (int)vol->brick_size;
 }
 
@@ -397,7 +397,7 @@ static void test_raycast_matches_cpu_reference(void **state)
         umbra_shadow_desc sh;
         umbra_shadow_desc_init(&sh);
         sh.technique = c->technique;
-        sh.reference_step = 0.5f;
+        sh.reference.step = 0.5f;
 
         umbra_renderer r = test_renderer(ctx, sc.volume, sc.tf, &cam, &light, &o);
         assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
@@ -571,7 +571,7 @@ static umbra_renderer scene_renderer(umbra_context ctx, umbra_scene *sc, const c
     umbra_shadow_desc sh;
     umbra_shadow_desc_init(&sh);
     sh.technique = technique;
-    sh.reference_step = 0.5f;
+    sh.reference.step = 0.5f;
     assert_int_equal(umbra_renderer_set_shadow(r, &sh), UMBRA_SUCCESS);
     return r;
 }
@@ -989,8 +989,9 @@ static void test_bad_inputs(void **state)
     sh.struct_size = sizeof sh + 8;
     EXPECT(umbra_renderer_set_shadow(r, &sh), BAD, "struct_size");
     umbra_shadow_desc_init(&sh);
-    sh.reference_step = 0.0f;
-    EXPECT(umbra_renderer_set_shadow(r, &sh), BAD, "reference_step 0");
+    sh.technique = UMBRA_SHADOW_REFERENCE;
+    sh.reference.step = 0.0f;
+    EXPECT(umbra_renderer_set_shadow(r, &sh), BAD, "reference reference_step 0");
     umbra_shadow_technique parsed;
     assert_int_equal(umbra_shadow_technique_parse("nonesuch", &parsed), BAD);
     assert_null(umbra_shadow_technique_name((umbra_shadow_technique)99));

@@ -372,9 +372,9 @@ static void compare_techniques(umbra_context ctx, umbra_scalar_type type, unsign
         umbra_shadow_desc sd;
         umbra_shadow_desc_init(&sd);
         sd.technique = cases[c].technique;
-        sd.map_size = 96;
-        sd.max_nodes = cases[c].max_nodes;
-        sd.reference_step = 0.5f;
+        sd.map.size = 96;
+        sd.deep.max_nodes = cases[c].max_nodes;
+        sd.reference.step = 0.5f;
         /* The convolution technique wants the light from the viewer's side. */
         umbra_light light = cases[c].technique == UMBRA_SHADOW_CONVOLUTION
                                 ? test_directional_light(-0.5f, -0.4f, -1.0f)

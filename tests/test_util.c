@@ -2,12 +2,14 @@
 /* tests/test_util.c: see test_util.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "internal.h" /* test_read_voxels reads the volume's device copy */
+#include "conformance.h"
 #include "test_util.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 umbra_context test_context(void)
 {
@@ -76,18 +78,7 @@ void test_assert_failed(umbra_context ctx, umbra_status got, umbra_status expect
 double test_path_in_box(const double p[3], const double dir[3], const double half[3],
                         double t_max)
 {
-    double lo = 0.0, hi = t_max;
-    for (int a = 0; a < 3; ++a) {
-        if (dir[a] == 0.0) {
-            if (p[a] < -half[a] || p[a] > half[a])
-                return 0.0;
-            continue;
-        }
-        double ta = (-half[a] - p[a]) / dir[a], tb = (half[a] - p[a]) / dir[a];
-        lo = fmax(lo, fmin(ta, tb));
-        hi = fmin(hi, fmax(ta, tb));
-    }
-    return hi > lo ? hi - lo : 0.0;
+    return conf_path_in_box(p, dir, half, t_max);
 }
 
 float *test_read_voxels(umbra_volume vol)
@@ -192,20 +183,8 @@ umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t n
 umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                 const float *data, uint32_t brick_size)
 {
-    umbra_volume_desc d;
-    umbra_volume_desc_init(&d);
-    d.data = data;
-    d.type = UMBRA_FLOAT32;
-    d.dims[0] = nx;
-    d.dims[1] = ny;
-    d.dims[2] = nz;
-    d.value_range_given = 1;
-    d.value_min = 0.0f;
-    d.value_max = 1.0f;
-    if (brick_size)
-        d.brick_size = brick_size;
     umbra_volume v = NULL;
-    assert_int_equal(umbra_volume_create(ctx, &d, &v), UMBRA_SUCCESS);
+    assert_int_equal(conf_volume_of(ctx, nx, ny, nz, data, brick_size, &v), UMBRA_SUCCESS);
     return v;
 }
 
@@ -250,24 +229,12 @@ umbra_renderer test_renderer_transmission(umbra_context ctx, umbra_volume volume
 
 umbra_light test_directional_light(float x, float y, float z)
 {
-    umbra_light l;
-    memset(&l, 0, sizeof l);
-    l.type = UMBRA_LIGHT_DIRECTIONAL;
-    l.direction[0] = x;
-    l.direction[1] = y;
-    l.direction[2] = z;
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    return l;
+    return conf_directional(x, y, z);
 }
 
 umbra_light test_point_light(float x, float y, float z)
 {
-    umbra_light l = test_directional_light(0.0f, -1.0f, 0.0f);
-    l.type = UMBRA_LIGHT_POINT;
-    l.position[0] = x;
-    l.position[1] = y;
-    l.position[2] = z;
-    return l;
+    return conf_point(x, y, z);
 }
 
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha)
@@ -276,4 +243,31 @@ umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float al
     umbra_transfer_function tf = NULL;
     assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
     return tf;
+}
+
+void test_cli_renders_with_named_preset(umbra_context ctx, const char *volume,
+                                        const char *out_name)
+{
+    const char *exe = getenv("UMBRA_RENDER") ? getenv("UMBRA_RENDER") : "./umbra-render";
+    char out[1024], cmd[4096];
+    uint32_t w = 0, h = 0;
+    float *rgba = NULL;
+    test_tmp_path(out, sizeof out, out_name);
+    assert_int_equal(access(exe, X_OK), 0);
+    snprintf(cmd, sizeof cmd,
+             "'%s' --volume '%s' --tf 'Cool to Warm' --technique cssm --size 48x48 --no-ground "
+             "--out '%s' 2>/dev/null",
+             exe, volume, out);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(umbra_image_read(ctx, out, &w, &h, &rgba), UMBRA_SUCCESS);
+    assert_int_equal(w, 48);
+    {
+        const float *centre = rgba + 4 * (24 * 48 + 24), *corner = rgba;
+        print_message("centre %g %g %g, corner %g %g %g\n", (double)centre[0],
+                      (double)centre[1], (double)centre[2], (double)corner[0], (double)corner[1],
+                      (double)corner[2]);
+        assert_float_equal(corner[0], 0.08, 0.01);
+        assert_true(fabsf(centre[0] - corner[0]) + fabsf(centre[2] - corner[2]) > 0.05f);
+    }
+    free(rgba);
 }

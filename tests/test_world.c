@@ -70,7 +70,7 @@ static void set_technique(umbra_renderer r, umbra_shadow_technique t)
     umbra_shadow_desc s;
     umbra_shadow_desc_init(&s);
     s.technique = t;
-    s.map_size = 128;
+    s.map.size = 128;
     assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
 }
 
@@ -302,7 +302,7 @@ static void test_query_shadow_in_rotated_box_matches_exp(void **state)
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = UMBRA_SHADOW_REFERENCE;
-    sd.reference_step = 0.25f;
+    sd.reference.step = 0.25f;
     assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
     float pts[3 * QUERY_POINTS], rgb[3 * QUERY_POINTS];
     double local[QUERY_POINTS][3];

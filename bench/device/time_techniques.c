@@ -59,9 +59,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "time_techniques: bad arguments\n");
         return 1;
     }
-    static const umbra_shadow_technique techs[] = {
-        UMBRA_SHADOW_NONE, UMBRA_SHADOW_REFERENCE, UMBRA_SHADOW_THRESHOLD,
-        UMBRA_SHADOW_CSSM, UMBRA_SHADOW_DEEP, UMBRA_SHADOW_CONVOLUTION};
     umbra_context ctx = NULL;
     umbra_scene scene = {0};
     umbra_renderer r = NULL;
@@ -82,16 +79,18 @@ int main(int argc, char **argv)
            umbra_context_device_name(ctx), umbra_version(), scene_name, res, w, h, frames);
     printf("| technique | camera orbit: frame ms | light orbit: frame ms | build ms (stats) | "
            "render ms (stats) | shadow memory MiB |\n|---|---|---|---|---|---|\n");
-    for (size_t t = 0; t < sizeof techs / sizeof techs[0]; ++t) {
+    /* Every technique of the registry, in its order. */
+    for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
+        const umbra_technique_info *ti = umbra_technique_get(t);
         umbra_shadow_desc sd;
         umbra_shadow_desc_init(&sd);
-        sd.technique = techs[t];
+        sd.technique = ti->id;
         umbra_render_stats stats;
         double *cam = wall, *lit = wall + frames, *build = wall + 2 * frames,
                *render = wall + 3 * frames;
         umbra_camera c0 = scene.camera;
         umbra_light l0 = scene.light;
-        if (techs[t] == UMBRA_SHADOW_CONVOLUTION) {
+        if (ti->flags & UMBRA_TECHNIQUE_FRAME) {
             /* Slices carry light front to back: a directional light from behind the viewer,
              * tilted 30 degrees downwards, within the technique's 80 degrees. */
             float d[3], up = 0.577f, n = 0.0f;
@@ -131,12 +130,12 @@ int main(int argc, char **argv)
             render[i] = stats.render_ms;
         }
         if (st) {
-            printf("| %s | failed: %s: %s | | | | |\n", umbra_shadow_technique_name(techs[t]),
+            printf("| %s | failed: %s: %s | | | | |\n", ti->name,
                    umbra_status_to_string(st), umbra_context_last_message(ctx));
             umbra_context_take_error(ctx, NULL);
             continue;
         }
-        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.1f |\n", umbra_shadow_technique_name(techs[t]),
+        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.1f |\n", ti->name,
                median(cam, frames), median(lit, frames), median(build, frames),
                median(render, frames), stats.shadow_memory_bytes / 1048576.0);
         fflush(stdout);

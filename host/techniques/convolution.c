@@ -83,24 +83,7 @@ static void rect_add(const UmbraFrame *F, const float p[3], float near, float lo
 
 static float conv_light_step(const umbra_shadow_desc *d)
 {
-    return d->slice_distance / (float)(d->subsamples + 1u);
-}
-
-static umbra_status conv_validate(umbra_renderer r, const umbra_shadow_desc *d)
-{
-    const char *fn = "umbra_renderer_set_shadow";
-    if (!(d->slice_distance >= 0.02f && d->slice_distance <= 16.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: slice_distance %g voxels must lie in [0.02, 16]", fn,
-                           d->slice_distance);
-    if (d->subsamples > 64)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: subsamples %u must be at most 64", fn, d->subsamples);
-    if (!(d->cone_angle_degrees >= 0.0f && d->cone_angle_degrees <= 60.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: cone_angle_degrees %g must lie in [0, 60]", fn,
-                           d->cone_angle_degrees);
-    return UMBRA_SUCCESS;
+    return d->convolution.slice_distance / (float)(d->convolution.subsamples + 1u);
 }
 
 /* Slice placement and the light check, from r->frame (camera part filled for this frame). */
@@ -158,10 +141,10 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
      * where a texel shrinks to nothing. */
     const float near = (F->flags & UMBRA_FLAG_ORTHO) ? 0.0f : 1e-3f * diag;
     G->z0 = fmaxf(zmin, near);
-    G->dz = r->shadow.slice_distance * umbra__voxel_world(r);
-    G->cone_tan = tanf(r->shadow.cone_angle_degrees * deg);
-    G->subsamples = r->shadow.subsamples;
-    G->pi_size = r->shadow.preintegrated ? UMBRA__PREINT_SIZE : 0u;
+    G->dz = r->shadow.convolution.slice_distance * umbra__voxel_world(r);
+    G->cone_tan = tanf(r->shadow.convolution.cone_angle_degrees * deg);
+    G->subsamples = r->shadow.convolution.subsamples;
+    G->pi_size = r->opts.preintegrated ? UMBRA__PREINT_SIZE : 0u;
     G->slices = 0;
     if (!(zmax > G->z0))
         return UMBRA_SUCCESS;
@@ -197,7 +180,8 @@ static umbra_status conv_geometry(umbra_renderer r, const char *fn, conv_geom *G
     if (n > CONV_MAX_SLICES)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: slice_distance %g voxels needs %.0f slices over a depth of %g "
-                           "voxels; at most %u are allowed", fn, r->shadow.slice_distance, n,
+                           "voxels; at most %u are allowed", fn,
+                           r->shadow.convolution.slice_distance, n,
                            (z_end - G->z0) / umbra__voxel_world(r), CONV_MAX_SLICES);
     G->slices = (uint32_t)n;
     G->rect[0] = 0;
@@ -334,7 +318,7 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     }
     cl_uint next = 0;
     /* Declared before the first UMBRA_CL: the fail path releases them. */
-    cl_event pending = NULL, mark = NULL;
+    cl_event pending = NULL, mark = NULL, sliced = NULL;
     if ((st = umbra__bind_common(r, s->slice, &next)) != UMBRA_SUCCESS)
         return st;
     const cl_uint base = next;
@@ -365,10 +349,10 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
     double t0 = umbra__now_ms();
     /* With a progress callback the slices go in groups of about UMBRA__BAND_SAMPLES samples:
      * after queueing a group the previous one is waited for and reported, so the device stays
-     * busy and a cancel waits for at most two groups. */
+     * busy and a cancel waits for at most two groups. An asynchronous frame waits for nothing. */
     const double per_slice = (double)range[0] * range[1] * (G.subsamples + 1u);
     uint32_t group = UINT32_MAX;
-    if (r->progress) {
+    if (r->progress && !r->async) {
         double budget = r->band_samples > 0.0 ? r->band_samples : UMBRA__BAND_SAMPLES;
         double g = budget / (per_slice > 1.0 ? per_slice : 1.0);
         group = g < 1.0 ? 1u : g > (double)n ? (n ? n : 1u) : (uint32_t)g;
@@ -393,8 +377,14 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         UMBRA_CL(clSetKernelArg(s->slice, base + 4, sizeof(cl_mem), &s->l[(i + 1) % 2]));
         UMBRA_CL(clSetKernelArg(s->slice, base + 5, sizeof(cl_mem), &s->l[i % 2]));
         UMBRA_CL(clSetKernelArg(s->slice, base + 9, sizeof ctl, &ctl));
+        cl_event *slot = i == 0 ? &first : r->async ? &sliced : NULL;
         UMBRA_CL(clEnqueueNDRangeKernel(ctx->queue, s->slice, 2, offset, range, local, 0, NULL,
-                                        i == 0 ? &first : NULL));
+                                        slot));
+        if (slot && (st = umbra__async_hold(r, *slot, 1)) != UMBRA_SUCCESS)
+            goto fail;
+        if (sliced)
+            clReleaseEvent(sliced);
+        sliced = NULL;
     }
     if (last == UINT32_MAX) {
         uint32_t k = G.slices ? (G.slices - 1) % 2 : 0;
@@ -408,9 +398,10 @@ static umbra_status conv_run(umbra_renderer r, uint32_t w, uint32_t h, cl_mem ou
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof geo, &geo));
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof ctl, &ctl));
         UMBRA_CL(clSetKernelArg(s->resolve, a++, sizeof rect, &rect));
-        if ((st = umbra__enqueue(ctx, s->resolve, 2, global, NULL, &end)))
+        if ((st = umbra__enqueue(ctx, s->resolve, 2, global, NULL, &end)) ||
+            (st = umbra__async_hold(r, end, 1)))
             goto fail;
-        if (r->async) { /* the caller marks the frame's end; nothing is timed */
+        if (r->async) { /* the caller hands out the resolve as the frame's end; nothing is timed */
             if (ms)
                 *ms = 0.0;
             ms = NULL;
@@ -442,6 +433,8 @@ fail:
         clReleaseEvent(pending);
     if (mark)
         clReleaseEvent(mark);
+    if (sliced)
+        clReleaseEvent(sliced);
     if (first)
         clReleaseEvent(first);
     if (end)
@@ -454,11 +447,56 @@ static umbra_status conv_render(umbra_renderer r, uint32_t w, uint32_t h, cl_mem
     return conv_run(r, w, h, out, UINT32_MAX, ms, NULL);
 }
 
+static const umbra__param params[] = {
+    UMBRA__PARAM(convolution, slice_distance, .doc = "distance between slices", .unit = "voxels",
+                 .default_value = 0.5, .min = 0.02, .max = 16),
+    UMBRA__PARAM(convolution, subsamples,
+                 .doc = "SCS: volume samples between two slices; the light is interpolated "
+                        "between the two",
+                 .default_value = 0, .min = 0, .max = 64),
+    UMBRA__PARAM(convolution, cone_angle_degrees, .alias = "cone_angle",
+                 .doc = "half-angle of the cone the kernel spreads the light over per slice "
+                        "(0: no blur)",
+                 .unit = "degrees", .default_value = 5, .min = 0, .max = 60),
+};
+
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"slice_distance=0.5;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 0.5",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 1",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"slice_distance=2;subsamples=0;preintegrated=0;cone_angle=5", "ICS slice 2",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=1;preintegrated=0;cone_angle=5", "SCS slice 2, 1 sub-sample",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=0;cone_angle=5", "SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=1;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 1",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=0;preintegrated=1;cone_angle=5", "pre-int. ICS slice 2",
+     UMBRA__SWEEP_FULL},
+    {"slice_distance=2;subsamples=3;preintegrated=1;cone_angle=5",
+     "pre-int. SCS slice 2, 3 sub-samples",
+     UMBRA__SWEEP_FULL},
+};
+
 const umbra__technique umbra__technique_convolution = {
-    .id = UMBRA_SHADOW_CONVOLUTION,
-    .kernel_file = NULL,
+    .info = {
+        .id = UMBRA_SHADOW_CONVOLUTION,
+        .name = "convolution",
+        .title = "slice-based convolution shadows (ICS / SCS)",
+        .doc = "Renders the frame itself in view-aligned slices front to back, carrying the "
+               "light from slice to slice through a blur kernel: soft shadows at the cost of a "
+               "kernel launch per slice every frame, for lights on the viewer's side only.",
+        .flags = UMBRA_TECHNIQUE_FRAME,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
+        .param_count = sizeof params / sizeof params[0],
+    },
+    .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
     .light_step = conv_light_step,
-    .validate = conv_validate,
     .render = conv_render,
     .memory = conv_memory,
     .destroy = conv_destroy,

@@ -25,6 +25,9 @@
 
 #include "lightspace.h"
 #include "techniques/deep.h"
+#include "techniques/deep_shared.h"
+
+_Static_assert(sizeof(UmbraDeep) == 16, "UmbraDeep layout");
 
 typedef struct deep_state {
     cl_program program;             /* owned by the context's cache */
@@ -35,6 +38,8 @@ typedef struct deep_state {
     uint64_t lut_key[4];            /* (light tf id, light step bits, channels, colored) */
     int lut_valid;
 
+    UmbraDeep constants;            /* the kernels' UmbraDeep, for the last build */
+    cl_mem constants_buf;
     cl_mem pool, next, head, counts, counter, fixed, dummy;
     size_t pool_blocks, head_count, counts_count, fixed_bytes;
     size_t block_bytes, node_bytes;
@@ -49,37 +54,10 @@ typedef struct deep_state {
     uint64_t builds, build_passes, lut_builds, pool_growths;
 } deep_state;
 
-static float deep_light_step(const umbra_shadow_desc *d)
-{
-    return umbra__map_step(d, UMBRA__MAP_STEP_DEEP);
-}
-
 /* Samples a texel's march takes, at most: the cost of a build launch (progress bands). */
 static double march_cost(umbra_renderer r)
 {
-    return umbra__ray_samples(r, deep_light_step(&r->shadow)) * r->shadow.prefilter;
-}
-
-static umbra_status deep_validate(umbra_renderer r, const umbra_shadow_desc *d)
-{
-    const char *fn = "umbra_renderer_set_shadow";
-    umbra_status st = umbra__lightspace_validate(r, d, "deep");
-    if (st != UMBRA_SUCCESS)
-        return st;
-    if (!(d->epsilon >= 0.0f && d->epsilon <= 1.0f))
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep epsilon %g must lie in [0, 1]", fn, d->epsilon);
-    if (d->max_nodes == 1 || d->max_nodes > 64)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep max_nodes %u must be 0 (unbounded) or lie in [2, 64]", fn,
-                           d->max_nodes);
-    if (d->block_size < 1 || d->block_size > 256)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep block_size %u must lie in [1, 256]", fn, d->block_size);
-    if (d->prefilter != 1 && d->prefilter != 5)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: deep prefilter %u must be 1 or 5", fn, d->prefilter);
-    return UMBRA_SUCCESS;
+    return umbra__ray_samples(r, umbra__map_light_step(&r->shadow)) * r->shadow.deep.prefilter;
 }
 
 static deep_state *state_get(umbra_renderer r)
@@ -140,16 +118,18 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/lightspace.cl",
-                           "techniques/deep.cl",
-                           "techniques/deep_budget.cl"};
+    static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/lightspace.cl"};
+    const char *files[8];
+    const size_t nfiles = umbra__program_files(r->tech, common, 3, "techniques/deep_budget.cl",
+                                               files, 8);
     char options[300];
     cl_program program;
     umbra__build_options(r, options, sizeof options - 48);
     const size_t used = strlen(options);
     snprintf(options + used, sizeof options - used, " -DDEEP_BUILD_KERNELS=1 -DDEEP_SUB_RAYS=%u",
-             r->shadow.prefilter);
-    if ((st = umbra__program_get(ctx, files, 5, options, &program)) != UMBRA_SUCCESS)
+             r->shadow.deep.prefilter);
+    if ((st = umbra__program_get(ctx, files, nfiles, options, &program)) != UMBRA_SUCCESS)
         return st;
     if (program == s->program && s->k_build)
         return UMBRA_SUCCESS;
@@ -215,7 +195,7 @@ static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    float step = deep_light_step(&r->shadow);
+    float step = umbra__map_light_step(&r->shadow);
     uint32_t step_bits;
     memcpy(&step_bits, &step, sizeof step_bits);
     uint64_t key[4] = {umbra__light_tf(r)->id, step_bits, r->channels,
@@ -251,8 +231,9 @@ static umbra_status bind_march(umbra_renderer r, deep_state *s, cl_kernel k, cl_
     if (st != UMBRA_SUCCESS)
         return st;
     cl_uint use_lut = s->lut_used ? 1u : 0u;
-    float eps = r->shadow.epsilon;
+    float eps = r->shadow.deep.epsilon;
     cl_mem lut = s->lut_used ? s->lut : s->dummy;
+    UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &s->constants_buf));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &lut));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof use_lut, &use_lut));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof eps, &eps));
@@ -347,7 +328,7 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
                                "epsilon %g needs more than %u blocks of %zu bytes, more than "
                                "the device's largest allocation (%llu bytes) holds; raise "
                                "epsilon or map_step, set max_nodes, or lower map_size", n, n,
-                               (double)r->shadow.epsilon, limit, s->block_bytes,
+                               (double)r->shadow.deep.epsilon, limit, s->block_bytes,
                                (unsigned long long)max_alloc);
         if (used <= capacity) {
             s->used_blocks = used;
@@ -373,7 +354,7 @@ static umbra_status build_fixed(umbra_renderer r, deep_state *s, double *ms)
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     const uint32_t n = s->map_size;
-    size_t bytes = (size_t)n * n * r->shadow.max_nodes * s->node_bytes;
+    size_t bytes = (size_t)n * n * r->shadow.deep.max_nodes * s->node_bytes;
     if ((st = ensure_size(ctx, &s->fixed, &s->fixed_bytes, bytes, "node array")) != UMBRA_SUCCESS)
         return st;
     cl_uint next = 0;
@@ -395,20 +376,20 @@ static umbra_status deep_build(umbra_renderer r, double *ms)
     deep_state *s = state_get(r);
     if (!s)
         return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "umbra_renderer_render: out of memory");
-    const umbra_shadow_desc *d = &r->shadow;
+    const umbra_deep_desc *d = &r->shadow.deep;
     if ((st = ensure_program(r, s)) != UMBRA_SUCCESS)
         return st;
-    UmbraShadow *S = &r->shadow_params;
-    umbra__lightspace_setup(r, d->map_size);
-    S->epsilon = d->epsilon;
-    S->block_size = d->block_size;
-    S->max_nodes = d->max_nodes;
-    S->depth_bias = 0.0f;
-    S->deep_tile = s->tile;
-    S->tiles_per_row = (S->map_size + s->tile - 1) / s->tile; /* the size chosen, if auto */
-    if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS)
+    const UmbraShadow *S = &r->shadow_params;
+    umbra__lightspace_setup(r, r->shadow.map.size);
+    s->constants.tile = s->tile;
+    s->constants.tiles_per_row = (S->map_size + s->tile - 1) / s->tile; /* the size chosen */
+    s->constants.block_size = d->block_size;
+    s->constants.max_nodes = d->max_nodes;
+    if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS ||
+        (st = umbra__upload_constants(r, &s->constants, sizeof s->constants,
+                                      &s->constants_buf)) != UMBRA_SUCCESS)
         return st;
-    s->tiles_per_row = S->tiles_per_row;
+    s->tiles_per_row = s->constants.tiles_per_row;
     s->block_size = d->block_size;
     s->channels = r->channels;
     s->max_nodes = d->max_nodes;
@@ -448,9 +429,10 @@ static umbra_status deep_bind(umbra_renderer r, cl_kernel k, cl_uint first)
     if (!s || !s->dummy || (s->fixed_mode ? !s->fixed : !s->pool))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_render: the deep shadow map has not been built");
-    cl_mem args[4] = {s->fixed_mode ? s->fixed : s->pool, s->fixed_mode ? s->dummy : s->head,
-                      s->fixed_mode ? s->dummy : s->next, s->fixed_mode ? s->dummy : s->counts};
-    for (cl_uint i = 0; i < 4; ++i)
+    cl_mem args[5] = {s->constants_buf, s->fixed_mode ? s->fixed : s->pool,
+                      s->fixed_mode ? s->dummy : s->head, s->fixed_mode ? s->dummy : s->next,
+                      s->fixed_mode ? s->dummy : s->counts};
+    for (cl_uint i = 0; i < 5; ++i)
         UMBRA_CL(clSetKernelArg(k, first + i, sizeof(cl_mem), &args[i]));
 fail:
     return st;
@@ -493,18 +475,111 @@ static void deep_destroy(umbra_renderer r)
     release_kernel(&s->k_build);
     release_kernel(&s->k_fixed);
     cl_mem *mems[] = {&s->lut, &s->pool, &s->next, &s->head, &s->counts, &s->counter, &s->fixed,
-                      &s->dummy};
+                      &s->dummy, &s->constants_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         release_mem(mems[i]);
     free(s);
     r->tech_state = NULL;
 }
 
+static const double prefilter_set[] = {1, 5};
+
+static const umbra__param params[] = {
+    UMBRA__MAP_PARAMS,
+    UMBRA__PARAM(deep, epsilon,
+                 .doc = "compression error bound: every visibility the march gave lies within "
+                        "epsilon of the stored function",
+                 .flags = UMBRA_PARAM_REBUILDS, .default_value = 0.02, .min = 0, .max = 1),
+    UMBRA__PARAM(deep, max_nodes, .alias = "nodes",
+                 .doc = "fixed budget of nodes per texel: the nodes kept are chosen once the "
+                        "whole ray is known, for the least error",
+                 .flags = UMBRA_PARAM_ZERO | UMBRA_PARAM_REBUILDS, .default_value = 0, .min = 2,
+                 .max = 64, .zero_doc = "unbounded"),
+    UMBRA__PARAM(deep, block_size,
+                 .doc = "node layers per block of the unbounded map's pool",
+                 .flags = UMBRA_PARAM_REBUILDS, .default_value = 8, .min = 1, .max = 256),
+    UMBRA__PARAM(deep, prefilter,
+                 .doc = "sub-pixel rays per texel (the paper's pre-filter)",
+                 .flags = UMBRA_PARAM_REBUILDS, .default_value = 1, .min = 1, .max = 5,
+                 .allowed = prefilter_set, .allowed_count = 2),
+    UMBRA__PARAM(deep, lookup_table,
+                 .doc = "compress through the pre-compressed segment table",
+                 .flags = UMBRA_PARAM_REBUILDS, .default_value = 1, .min = 0, .max = 1),
+};
+
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+static const umbra__setting sweep[] = {
+    {"max_nodes=3", "deep", UMBRA__SWEEP_BUILDS}, /* epsilon stays at its default, 0.02 */
+    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1", "auto size, ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;epsilon=0.02;max_nodes=0;prefilter=1", "512², ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;epsilon=0.02;max_nodes=0;prefilter=1", "1024², ε 0.02",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;epsilon=0.02;max_nodes=0;prefilter=1", "2048², ε 0.02",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1;map_texels_per_voxel=1",
+     "auto size, ε 0.02, draft",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
+    {"map_size=512;epsilon=0.02;max_nodes=3;prefilter=1", "512², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_QUICK | UMBRA__SWEEP_HEADLINE_QUICK},
+    {"map_size=1024;epsilon=0.02;max_nodes=3;prefilter=1", "1024², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
+    {"map_size=2048;epsilon=0.02;max_nodes=3;prefilter=1", "2048², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=4096;epsilon=0.02;max_nodes=3;prefilter=1", "4096², ε 0.02, 3 nodes",
+     UMBRA__SWEEP_PAPERS_CSSM},
+    {"map_size=1024;epsilon=0.02;max_nodes=2;prefilter=1", "1024², ε 0.02, 2 nodes",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.02;max_nodes=6;prefilter=1", "1024², ε 0.02, 6 nodes",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.01;max_nodes=0;prefilter=1", "1024², ε 0.01",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.06;max_nodes=0;prefilter=1", "1024², ε 0.06",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.1;max_nodes=0;prefilter=1", "1024², ε 0.1",
+     UMBRA__SWEEP_FULL},
+    {"map_size=1024;epsilon=0.02;max_nodes=0;prefilter=5", "1024², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=128;epsilon=0.02;max_nodes=0;prefilter=5", "128², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=128;epsilon=0.06;max_nodes=0;prefilter=5", "128², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=256;epsilon=0.02;max_nodes=0;prefilter=5", "256², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=256;epsilon=0.06;max_nodes=0;prefilter=5", "256², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=512;epsilon=0.02;max_nodes=0;prefilter=5", "512², ε 0.02, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+    {"map_size=512;epsilon=0.06;max_nodes=0;prefilter=5", "512², ε 0.06, 5-tap prefilter",
+     UMBRA__SWEEP_PAPERS_DEEP},
+};
+
+static const char *const kernel_files[] = {"techniques/deep_shared.h", "techniques/deep.cl",
+                                           NULL};
+
 const umbra__technique umbra__technique_deep = {
-    .id = UMBRA_SHADOW_DEEP,
-    .kernel_file = "techniques/deep.cl",
-    .light_step = deep_light_step,
-    .validate = deep_validate,
+    .info = {
+        .id = UMBRA_SHADOW_DEEP,
+        .name = "deep",
+        .title = "deep shadow map (Hadwiger et al. 2006)",
+        .doc = "Per texel of a light-space map, the visibility along the light ray as a "
+               "piecewise-linear function compressed within epsilon, per light channel: close "
+               "to the reference on translucent and coloured material; memory grows with the "
+               "function's nodes (or is fixed by a node budget).",
+        .flags = UMBRA_TECHNIQUE_MAP,
+        .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
+        .param_count = sizeof params / sizeof params[0],
+        /* A nearest-texel lookup: its error keeps falling with the size; two texels per voxel
+         * halve the error of one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
+        .map_texels_per_voxel = 2.0f,
+        .map_step = 0.5f, /* lightspace.h: its nodes follow the sampled visibility */
+    },
+    .params = params,
+    .sweep = sweep,
+    .sweep_count = sizeof sweep / sizeof sweep[0],
+    .kernel_files = kernel_files,
+    .light_step = umbra__map_light_step,
     .build = deep_build,
     .bind = deep_bind,
     .memory = deep_memory,
@@ -520,7 +595,7 @@ static umbra_status check_deep(umbra_renderer r, const char *fn)
     if (r->tech != &umbra__technique_deep)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: the renderer's technique is '%s', not 'deep'", fn,
-                           umbra_shadow_technique_name(r->tech->id));
+                           r->tech->info.name);
     return UMBRA_SUCCESS;
 }
 

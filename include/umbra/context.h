@@ -10,7 +10,8 @@
  * never interfere. Objects of one context may also be used on different threads at once (two
  * renderers rendering on two threads share the program cache, the queue and the error state
  * safely; reference counts are atomic), but each object (a renderer, a volume being created or
- * released) by one thread at a time. The error state is then shared: umbra_context_take_error
+ * released) by one thread at a time (a call on a renderer in the middle of a render on another
+ * thread is refused, UMBRA_ERROR_INVALID_ARGUMENT). The error state is then shared: umbra_context_take_error
  * and umbra_context_last_message return whichever thread's error came first or last, and their
  * message pointers may be overwritten by the next error on any thread; for per-call errors across
  * threads, use the callback, which runs on the thread whose call failed.
@@ -48,9 +49,16 @@
  *    (umbra's own queues always have it), else the host's wall clock from enqueue to completion,
  *    which includes any work queued ahead of umbra's.
  *
- * 5. Process-wide state. umbra's only mutable globals are mutexes: one serialises device
- *    discovery (OpenCL start-up is process-wide, and PoCL's is not thread-safe), and umbra_io
- *    holds one each around Teem, nifticlib and cJSON, which keep process-wide state of their own.
+ * 5. Process-wide state. umbra's only mutable globals are mutexes and one process id: a mutex
+ *    serialises device discovery (OpenCL start-up is process-wide, and PoCL's is not
+ *    thread-safe), umbra_io holds one each around Teem, nifticlib and cJSON, which keep
+ *    process-wide state of their own, and umbra records which process first started OpenCL.
+ *    OpenCL does not survive fork() (PoCL's device threads do not exist in the child, whose
+ *    commands wait forever): in a child forked after that, every call that would use OpenCL
+ *    (context, volume and transfer-function creation, renders, queries) returns
+ *    UMBRA_ERROR_UNSUPPORTED at once with a message saying what to do, and releasing inherited
+ *    objects frees nothing (they are the parent's). Create contexts in the process that uses
+ *    them, after any fork() (Python: multiprocessing's "spawn" or "forkserver" start method).
  *    umbra installs no signal or exit handlers and starts no threads (the OpenCL implementation
  *    may). It touches the environment only in
  *    umbra_context_create, and the application can turn each off in the description:
@@ -65,8 +73,13 @@
 #ifndef UMBRA_CONTEXT_H
 #define UMBRA_CONTEXT_H
 
-/* umbra defines no CL_TARGET_OPENCL_VERSION for the application: it uses OpenCL 1.2 calls only,
- * and any newer target the application chooses compiles against these declarations. */
+/* umbra uses OpenCL 1.2 calls only, and any target the application chooses with
+ * CL_TARGET_OPENCL_VERSION compiles against these declarations. An application that chose none
+ * gets the OpenCL headers' own default, 3.0 (300), as CL/cl_version.h would set it, only without
+ * the note cl_version.h prints into every file that includes this header. */
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 300
+#endif
 #include <CL/cl.h>
 #include <stddef.h>
 

@@ -27,6 +27,7 @@
 #include <stdint.h>
 
 #include "umbra/context.h"
+#include "umbra/techniques/list.h"
 #include "umbra/transfer_function.h"
 #include "umbra/volume.h"
 
@@ -87,7 +88,7 @@ typedef enum umbra_transmission {
 } umbra_transmission;
 
 /* Bound on the samples one ray may take: the box diagonal over the step, for view rays (step),
- * shadow rays (reference_step) and light rays (map_step, slice_distance / (subsamples + 1)). A
+ * shadow rays (reference step) and light rays (map step, slice_distance / (subsamples + 1)). A
  * render (or query) whose volume and steps would exceed it fails with
  * UMBRA_ERROR_INVALID_ARGUMENT naming the count and this limit, before any work: such a volume
  * is too anisotropic or too large for the step (raise the step, or resample the volume). */
@@ -113,20 +114,28 @@ typedef struct umbra_render_desc {
                                 the plane, as a fraction of the box diagonal (default 0.02;
                                 negative lifts it into the box) */
     umbra_transmission transmission; /* default UMBRA_TRANSMISSION_GREY */
+    /* Fields below were added after umbra 0.4; a desc whose struct_size is that layout's size
+     * (offsetof(umbra_render_desc, preintegrated)) is accepted and leaves them as they were (a
+     * 0.4 caller sets preintegrated through its umbra_shadow_desc). */
+    int preintegrated;       /* nonzero: pre-integrated segments (a 2D table over front and back
+                                value, rebuilt when the transfer function or the segment length
+                                changes): every ray-cast technique pre-integrates the view ray's
+                                segments of length `step`, and the convolution technique
+                                attenuates the light with the segment's pre-integrated
+                                transmittance (default 0) */
 } umbra_render_desc;
 
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_render_desc_init(umbra_render_desc *desc);
 
+/* The shadow techniques: UMBRA_SHADOW_NONE (factor 1 everywhere), _REFERENCE, _THRESHOLD, _CSSM,
+ * _DEEP and _CONVOLUTION, made from the registry's list (umbra/techniques/list.h). What each one
+ * is and does: its header umbra/techniques/<name>.h, and at run time umbra_technique_find_id()
+ * (umbra/registry.h). */
 typedef enum umbra_shadow_technique {
-    UMBRA_SHADOW_NONE = 0,       /* shadow factor 1 everywhere */
-    UMBRA_SHADOW_REFERENCE = 1,  /* exact: a shadow ray marched from every sample */
-    UMBRA_SHADOW_THRESHOLD = 2,  /* opacity-threshold shadow map: grey and binary, it ignores
-                                    the transmission colour, so in coloured scenes where light
-                                    passes coloured material it can be worse than no shadows */
-    UMBRA_SHADOW_DEEP = 3,       /* deep shadow map (Hadwiger et al. 2006) */
-    UMBRA_SHADOW_CSSM = 4,       /* colored stochastic shadow map (Weidner & Linsen) */
-    UMBRA_SHADOW_CONVOLUTION = 5 /* slice-based convolution shadows (ICS / SCS) */
+#define UMBRA__TECHNIQUE_ENUM(name, NAME, id, member) UMBRA_SHADOW_##NAME = id,
+    UMBRA_TECHNIQUE_LIST(UMBRA__TECHNIQUE_ENUM)
+#undef UMBRA__TECHNIQUE_ENUM
 } umbra_shadow_technique;
 
 /* Name used by the CLI ("reference"), or NULL for an unknown value. */
@@ -134,96 +143,64 @@ UMBRA_API const char *umbra_shadow_technique_name(umbra_shadow_technique techniq
 /* Parses a name; UMBRA_ERROR_INVALID_ARGUMENT for an unknown one. */
 UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shadow_technique *out);
 
-/* map_size UMBRA_MAP_SIZE_AUTO (the default) lets each build of a light-space map choose its
+/* size UMBRA_MAP_SIZE_AUTO (the default) lets each build of a light-space map choose its
  * resolution from the volume's footprint as the light sees it: k texels per voxel (the smallest
- * spacing) across the box's projection, k = 1 for the threshold map (one depth per texel: finer
- * maps sample the same voxels again), 3 for CSSM (its taps are fixed in texels, radius 4 for 13
- * taps, so fewer texels per voxel blur the shadow over several voxels) and 2 for the deep map
- * (nearest-texel lookup: its error keeps falling with the size; README, "Map size"). A
- * directional light's orthographic map gets k times the wider side of the box's projection in
- * voxels; a point light's frustum the same measured at the distance of the box's centre (the near
- * side gets more texels per voxel, the far side fewer); a point light inside or near the box
- * (octahedral map over every direction) k sqrt(4 pi) R / voxel, R the distance to the farthest
- * corner. map_texels_per_voxel replaces k where it is set: an application that rebuilds the map
- * every frame while the user drags the light can ask for 1 (a draft at the threshold map's size:
- * CSSM builds 5x to 8x faster, the deep map 3x to 4x; README "Map size") and go back to 0 when
- * the light stops. The result is rounded up to a multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole
- * deep-map tiles) and bounded to [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen
- * again whenever the map is rebuilt (the light or volume changed); umbra_render_stats.map_size says
- * what was chosen. On the walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
+ * spacing) across the box's projection, k the technique's own (umbra_technique_info's
+ * map_texels_per_voxel: 1 for the threshold map, one depth per texel: finer maps sample the same
+ * voxels again; 3 for CSSM, whose taps are fixed in texels, radius 4 for 13 taps, so fewer texels
+ * per voxel blur the shadow over several voxels; 2 for the deep map, a nearest-texel lookup whose
+ * error keeps falling with the size; README, "Map size"). A directional light's orthographic map
+ * gets k times the wider side of the box's projection in voxels; a point light's frustum the same
+ * measured at the distance of the box's centre (the near side gets more texels per voxel, the far
+ * side fewer); a point light inside or near the box (octahedral map over every direction)
+ * k sqrt(4 pi) R / voxel, R the distance to the farthest corner. texels_per_voxel replaces k where
+ * it is set: an application that rebuilds the map every frame while the user drags the light can
+ * ask for 1 (a draft at the threshold map's size: CSSM builds 5x to 8x faster, the deep map 3x to
+ * 4x; README "Map size") and go back to 0 when the light stops. The result is rounded up to a
+ * multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map tiles) and bounded to
+ * [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again whenever the map is
+ * rebuilt (the light or volume changed); umbra_render_stats.map_size says what was chosen. On the
+ * walnut (128 x 96 x 114, point light) that is 192^2, 512^2 and 352^2. */
 #define UMBRA_MAP_SIZE_AUTO 0u
 #define UMBRA_MAP_SIZE_AUTO_MIN 64u
 #define UMBRA_MAP_SIZE_AUTO_MAX 2048u
 #define UMBRA_MAP_SIZE_AUTO_ROUND 32u
 
+/* What every light-space map (a technique with UMBRA_TECHNIQUE_MAP: threshold, cssm, deep) reads;
+ * the others ignore it. Keys (umbra/registry.h): map_size, map_texels_per_voxel, map_step. */
+typedef struct umbra_map_desc {
+    uint32_t size;          /* map resolution, size^2 texels: UMBRA_MAP_SIZE_AUTO (0, the
+                               default: chosen from the scene, rule above) or 16..8192;
+                               umbra_render_stats.map_size reports the size built */
+    float texels_per_voxel; /* UMBRA_MAP_SIZE_AUTO only: texels per voxel across the box's
+                               projection, 0 (the default: the technique's own, rule above) or
+                               [0.25, 8]; a fixed size ignores it */
+    float step;             /* light-ray step in voxels: 0 (the default: the technique's own,
+                               umbra_technique_info.map_step: 1 for the threshold map and CSSM,
+                               0.5 for the deep map, README "Map size") or [0.01, 64] */
+} umbra_map_desc;
+
+/* The shadow technique and the parameters of every technique, each in its own member (the
+ * active technique's are the ones read, validated and compared when deciding a rebuild): the
+ * members come from the registry's list (umbra/techniques/list.h), and umbra/registry.h reads
+ * and sets any parameter by name with its range checked. Older layouts are accepted by
+ * struct_size: umbra 0.4's flat struct (with the 0.4 `preintegrated`, which then sets the
+ * renderer's umbra_render_desc.preintegrated), and this struct as an earlier list made it (the
+ * techniques appended since take their defaults). */
 typedef struct umbra_shadow_desc {
-    size_t struct_size;          /* sizeof(umbra_shadow_desc); set by umbra_shadow_desc_init */
+    size_t struct_size;               /* sizeof(umbra_shadow_desc); set by umbra_shadow_desc_init */
     umbra_shadow_technique technique; /* default UMBRA_SHADOW_NONE */
-    /* reference */
-    float reference_step;        /* shadow-ray step in voxels (default 0.25) */
-    /* light-space maps */
-    uint32_t map_size;           /* map resolution, map_size^2 texels: UMBRA_MAP_SIZE_AUTO
-                                    (0, the default: chosen from the scene, rule below) or
-                                    16..8192; stats.map_size reports the size built */
-    float map_texels_per_voxel;  /* UMBRA_MAP_SIZE_AUTO only: texels per voxel across the box's
-                                    projection, 0 (the default: the technique's own, 1 threshold,
-                                    3 CSSM, 2 deep; rule above) or [0.25, 8]; a fixed map_size
-                                    ignores it */
-    float map_step;              /* light-ray step in voxels: 0 (the default: the technique's
-                                    own, 1 for the threshold map and CSSM, 0.5 for the deep
-                                    map, README "Map size") or [0.01, 64] */
-    float threshold;             /* threshold map: accumulated light opacity in (0, 1) at which
-                                    a texel's depth is stored (default 0.5); one grey depth per
-                                    texel, map_size^2 * 4 bytes. Everything behind that depth is
-                                    black in every channel, even where coloured transmission lets
-                                    light through (README, "Opacity-threshold shadow map") */
-    uint32_t taps;               /* CSSM / filtered threshold: texels averaged per lookup, 1, 7,
-                                    13 (the paper's set) or 21 (default 13); the offsets are
-                                    listed in kernels/common/lightspace.cl. They are fixed in
-                                    texels:
-                                    more taps reach farther (radius 4, 7, 10), trading noise for
-                                    a wider blur of shadow edges */
-    float epsilon;               /* deep map: compression error bound in [0, 1] (default 0.02) */
-    uint32_t max_nodes;          /* deep map: fixed budget of nodes per texel, 0 (unbounded) or
-                                    2..64; a node holds a depth and every channel's visibility
-                                    (4 floats for coloured light: 3 nodes = 12 values). The
-                                    nodes kept are chosen once the whole ray is known, for the
-                                    least error; the stored function never rises and its end
-                                    value is the unbounded map's */
-    uint32_t block_size;         /* deep map: node layers per block, 1..256 (default 8) */
-    uint32_t prefilter;          /* deep map: sub-pixel rays per texel, 1 or 5 (default 1) */
-    int lookup_table;            /* deep map: use the pre-compressed segment table (default 1) */
-    uint32_t seed;               /* CSSM: seed of the counter-based random numbers (default 1):
-                                    the same seed gives the same map and image, bit for bit, on
-                                    the same device. The map holds one depth per simulated light
-                                    channel (3, or 1 for a grey light): map_size^2 * 12 or 4
-                                    bytes */
-    uint32_t ray_block;          /* CSSM: texels per side of the square blocks whose photons
-                                    share one light ray (through the block's centre; each photon
-                                    keeps its own random number): 0 (the default: the map's
-                                    whole texels per voxel, at most 3, so that a block spans no
-                                    more than a voxel), 1 (a ray per texel, as in the paper), 2
-                                    or 3; README "Colored stochastic shadow map" */
-    /* convolution: the technique renders the frame itself with view-aligned slices (ICS). The
-     * light must come from the viewer's side: a directional light within 80 degrees of the view
-     * direction, a point light from which every corner of the box lies within 80 degrees of it;
-     * others give UMBRA_ERROR_UNSUPPORTED. The view step and jitter are not used (the slices
-     * set the sampling); the ground plane is supported. */
-    float slice_distance;        /* voxels between slices, [0.02, 16] (default 0.5) */
-    uint32_t subsamples;         /* SCS: volume samples between two slices, 0..64 (default 0);
-                                    the volume is sampled every slice_distance/(subsamples+1)
-                                    and the light interpolated between the two slices */
-    int preintegrated;           /* nonzero: pre-integrated segments (a 2D table over front and
-                                    back value, rebuilt when the transfer function or the
-                                    segment length changes); for the convolution technique the
-                                    light is attenuated with the segment's pre-integrated
-                                    transmittance, for every ray-cast technique the view ray's
-                                    segments of length `step` are pre-integrated (default 0) */
-    float cone_angle_degrees;    /* half-angle of the cone the convolution kernel spreads the
-                                    light over per slice, [0, 60] (default 5; 0: no blur) */
+    uint32_t reserved;                /* 0 (umbra_shadow_desc_init); unread. Without it this
+                                         layout would have the size of umbra 0.4's, which
+                                         struct_size must tell apart */
+    umbra_map_desc map;               /* the light-space maps' shared parameters */
+#define UMBRA__TECHNIQUE_MEMBER(name, NAME, id, member) member
+    UMBRA_TECHNIQUE_LIST(UMBRA__TECHNIQUE_MEMBER)
+#undef UMBRA__TECHNIQUE_MEMBER
 } umbra_shadow_desc;
 
-/* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
+/* Fills desc with every parameter's default (the registry's, umbra/registry.h; the headers give
+ * them beside each field) and struct_size; NULL is a no-op. */
 UMBRA_API void umbra_shadow_desc_init(umbra_shadow_desc *desc);
 
 /* Creates a renderer on ctx (retained). */
@@ -270,9 +247,22 @@ UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer(umbra_renderer r, uint
  * light only once those can complete. When nothing needs building (e.g. only the camera moved)
  * the call waits for nothing. Per-frame constants are copied at the call; the renderer, volume,
  * transfer functions and rgba may be changed or released as soon as it returns (OpenCL keeps
- * what the enqueued commands use until they complete). The frame's stats have
+ * what the enqueued commands use until they complete).
+ *
+ * *done is the frame's last kernel (the ray caster's; the convolution technique's resolve): its
+ * profiling counters, when the queue has profiling, time that kernel, which for every technique
+ * but convolution is the frame's device work. Until *done has completed the stats have
  * render_timing UMBRA_TIMING_NONE, render_ms 0 and samples 0 (the call does not wait for them);
- * the device time is available from *done when the queue has profiling. */
+ * once it has, umbra_renderer_get_stats gives the frame's device time (first kernel's start to
+ * last kernel's end, UMBRA_TIMING_DEVICE) until the next frame. Samples stay 0.
+ *
+ * A wait-list event that ends in an error (clSetUserEventStatus with a negative status, a failed
+ * command) fails the frame: none of its commands run, rgba is left as it was, and *done ends with
+ * a negative status, as do later frames queued behind it on the same in-order queue. An event
+ * that has already failed at the call is refused (UMBRA_ERROR_INVALID_ARGUMENT): PoCL would never
+ * run the frame. umbra holds every command of the frame until it has ended: PoCL 3.1 aborts the
+ * process when such a failure reaches a command nobody holds, so commands the application queues
+ * behind a wait-list event or behind *done need events it holds until they end too. */
 UMBRA_API umbra_status umbra_renderer_render_to_cl_buffer_async(umbra_renderer r, uint32_t width,
                                                                 uint32_t height, cl_mem rgba,
                                                                 cl_uint num_wait,
@@ -314,13 +304,20 @@ typedef struct umbra_render_stats {
 UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_stats *out);
 
 /* Progress and cancellation of long calls. Called on the calling thread during
- * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow,
- * between pieces of device work (bands of rows of the image or of the shadow map, groups of
- * convolution slices), with the fraction of the call's work done: in [0, 1], non-decreasing,
- * and exactly 1 in the last call of a call that succeeds. Return nonzero to cancel: the call
- * waits for the piece in flight (bands are sized to about 2^25 samples), then returns
- * UMBRA_ERROR_CANCELLED; the renderer stays usable (the next render rebuilds what was cut
- * short). The callback must not call this renderer. */
+ * umbra_renderer_render, umbra_renderer_render_to_cl_buffer and umbra_renderer_query_shadow
+ * (and the shadow build of an asynchronous frame), between pieces of device work (bands of the
+ * image, the query points or the shadow map, groups of convolution slices), with the fraction
+ * of the call's work done: in [0, 1], non-decreasing, and exactly 1 in the last call of a call
+ * that succeeds. Pieces are sized to about 2^24 samples of the work's upper bound, shadow and
+ * light rays included (a reference render marches a shadow ray from every view sample), but at
+ * least four work-groups per compute unit on a CPU (docs/performance.md: a reference render of
+ * 512^2 at steps 0.25 and 0.05 on 2 loaded cores reported at most 0.43 s apart and stopped
+ * within 0.27 s of a cancel; it had stopped 119 s after one). Return nonzero to cancel: the
+ * call waits for the piece in flight, then returns UMBRA_ERROR_CANCELLED; the renderer stays
+ * usable (the next render rebuilds what was cut short). The callback must not call this
+ * renderer: any call on it from the callback (or from another thread meanwhile) is refused with
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the call in progress; releasing it is allowed, the render
+ * finishes first. */
 typedef int (*umbra_progress_callback)(void *user, float fraction);
 
 /* Installs (or with NULL removes) the progress callback; user is passed to it (borrowed). With a

@@ -10,6 +10,7 @@
 #include "umbra/volume.h"
 #include "umbra/transfer_function.h"
 #include "umbra/renderer.h"
+#include "umbra/registry.h"
 #include "umbra/scene.h"
 
 #endif

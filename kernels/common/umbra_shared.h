@@ -68,35 +68,20 @@ typedef struct UmbraFrame {
 #define UMBRA_LS_PERSPECTIVE 1u /* point light outside the box: a frustum around it */
 #define UMBRA_LS_OCTAHEDRAL 2u  /* point light at, inside or very near the box: every direction */
 
-/* CSSM: the largest block side whose photons share a light ray (the kernel's arrays hold the
- * square of it; the host refuses more). */
-#define UMBRA_CSSM_MAX_RAY_BLOCK 3
-
-/* Per-technique shadow parameters. One struct for all techniques keeps the ray caster's
- * signature fixed; each technique uses the fields it documents. The ls_* fields describe the
- * light-space map (host/lightspace.c fills them, kernels/common/lightspace.cl reads them). */
+/* What every technique's light pass shares, filled by the renderer (step) and, for the
+ * light-space maps, by host/lightspace.c (the ls_* fields, near_far, map_size), which
+ * kernels/common/lightspace.cl reads. Each technique's own parameters go to the kernels in a
+ * struct of its own (kernels/techniques/<name>_shared.h), which its bind function passes. */
 typedef struct UmbraShadow {
     float ls_u[4], ls_v[4], ls_w[4]; /* light basis: u, v across the map, w along the light */
     float ls_origin[4];       /* point light position */
     float ls_window[4];       /* u_min, v_min, 1/(u_max-u_min), 1/(v_max-v_min): plane units
                                  (ortho) or tangents (perspective) */
     float near_far[4];        /* depth range along the light: near, far, 1/(far-near), unused */
-    float step;               /* reference / maps: light-ray step, world units */
-    float threshold;          /* threshold map */
-    float epsilon;            /* deep map */
-    uint32_t map_size;        /* texels per side */
-    uint32_t taps;            /* CSSM / filtered threshold: taps per lookup */
-    uint32_t channels;        /* 1 or 3 light channels */
-    uint32_t block_size;      /* deep map: node layers per block */
-    uint32_t tiles_per_row;   /* deep map: tiles per map row */
-    uint32_t max_nodes;       /* deep map: node budget per channel (0 = unbounded) */
-    uint32_t seed;            /* CSSM */
-    uint32_t ls_mode;         /* UMBRA_LS_* */
-    float depth_bias;         /* threshold / CSSM: normalised depth a sample must lie beyond a
-                                 stored depth to be shadowed by it */
-    uint32_t deep_tile;       /* deep map: tile edge in texels (16, or 8 on small work-groups) */
-    uint32_t ray_block;       /* CSSM: texels per side of a block whose photons share a ray */
-    uint32_t pad[10];         /* room for technique fields without changing the size */
+    float step;               /* the light-ray (or the reference's shadow-ray) step, world units */
+    uint32_t map_size;        /* light-space maps: texels per side */
+    uint32_t ls_mode;         /* light-space maps: UMBRA_LS_* */
+    uint32_t pad;
 } UmbraShadow;
 
 #endif

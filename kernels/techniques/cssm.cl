@@ -23,7 +23,7 @@
  *    per-segment test needed a random number per segment; and it lets photons share a ray:
  *
  * 2. The photons of a block of B x B texels share one light ray, through the block's centre
- *    (S->ray_block; B = 1 is the paper's ray per texel). Each keeps its own u, so the block's
+ *    (P->ray_block; B = 1 is the paper's ray per texel). Each keeps its own u, so the block's
  *    photons are independent draws on that ray: the march sorts their E and stops each photon
  *    where the optical depth passes its E, until the last one (in every channel) is stopped. The
  *    host's default B is the map's whole texels per voxel, at most 3, so that the rays a block
@@ -49,7 +49,7 @@
  * Lookup, the paper's Table 2: the m taps around the sample's texel (ls_taps); channel c is lit by
  * each tap whose stored depth lies beyond the sample's (c_lambda > s_z); the factor is j/m. */
 
-#define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
+#define SHADOW_KERNEL_PARAMS , __global const UmbraCssm *P, __global const float *shadow_map
 
 typedef struct ShadowRay {
     int unused;
@@ -102,15 +102,16 @@ inline light_t cssm_depth(float4 c, float len, uint flags)
 __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
-                         __global const UmbraShadow *S, __global float *map)
+                         __global const UmbraShadow *S, __global const UmbraCssm *P,
+                         __global float *map)
 {
-    const int n = (int)S->map_size, B = clamp((int)S->ray_block, 1, UMBRA_CSSM_MAX_RAY_BLOCK);
+    const int n = (int)S->map_size, B = clamp((int)P->ray_block, 1, UMBRA_CSSM_MAX_RAY_BLOCK);
     const int x0 = (int)get_global_id(0) * B, y0 = (int)get_global_id(1) * B;
     if (x0 >= n || y0 >= n)
         return;
     (void)view_tf;
     (void)view_bricks;
-    const uint seed = S->seed;
+    const uint seed = P->seed;
     const int bw = min(B, n - x0), bh = min(B, n - y0); /* the block's texels inside the map */
     /* The photons' optical-depth thresholds E = -ln(1 - u), sorted ascending, with their
      * texels (index j = row * B + column in the block). */
@@ -189,14 +190,15 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
 }
 
 /* Table 2: per channel, the fraction of the taps whose stored depth lies beyond p's. */
-UMBRA_INLINE float3 cssm_lookup(__global const UmbraShadow *S, __global const float *map, float3 p)
+UMBRA_INLINE float3 cssm_lookup(__global const UmbraShadow *S, __global const UmbraCssm *P,
+                                __global const float *map, float3 p)
 {
     const float3 m = ls_world_to_map(S, p);
     int2 base;
     if (!ls_base_texel(S, m.xy, &base))
         return (float3)(1.0f);
-    const uint taps = S->taps;
-    const float s = m.z - S->depth_bias;
+    const uint taps = P->taps;
+    const float s = m.z; /* no bias: the depths are segment midpoints (see above) */
     const int n = (int)S->map_size;
     light_t lit = (light_t)(0.0f);
     if (ls_taps_inside(n, base)) {
@@ -216,4 +218,4 @@ UMBRA_INLINE float3 cssm_lookup(__global const UmbraShadow *S, __global const fl
     return light_rgb(lit / (float)taps);
 }
 
-#define SHADOW_FACTOR(sr, p) cssm_lookup(S, shadow_map, (p))
+#define SHADOW_FACTOR(sr, p) cssm_lookup(S, P, shadow_map, (p))

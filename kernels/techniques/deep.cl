@@ -683,21 +683,22 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
 __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
-                         __global const UmbraShadow *S, __global const deep_node *lut,
-                         uint use_lut, float eps, __global deep_node *nodes,
+                         __global const UmbraShadow *S, __global const UmbraDeep *D,
+                         __global const deep_node *lut, uint use_lut, float eps,
+                         __global deep_node *nodes,
                          __global int *head, __global int *next, __global uint *counts,
                          volatile __global uint *counter, uint capacity, uint limit)
 {
     (void)view_tf;
     (void)view_bricks;
-    const int T = (int)S->deep_tile;
+    const int T = (int)D->tile;
     const int lane = (int)get_local_id(1) * T + (int)get_local_id(0);
     const int n = (int)S->map_size;
     const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
     /* From the global id, not the group id: the host may launch the map in bands of rows with a
      * global offset (host/renderer.c, umbra__run_2d). */
-    const int tile = (gy / T) * (int)S->tiles_per_row + gx / T;
-    const uint K = S->block_size;
+    const int tile = (gy / T) * (int)D->tiles_per_row + gx / T;
+    const uint K = D->block_size;
     const size_t T2 = (size_t)(T * T);
     const VolGeom g = vol_geom(F);
     __local int l_block;
@@ -778,8 +779,9 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
  * one; when that node lies deeper than the sample (the view ray moved toward the light) the search
  * restarts at the texel's first node. */
 #define SHADOW_KERNEL_PARAMS                                                                   \
-    , __global const deep_node *deep_nodes, __global const int *deep_head,                    \
-        __global const int *deep_next, __global const uint *deep_counts
+    , __global const UmbraDeep *D, __global const deep_node *deep_nodes,                      \
+        __global const int *deep_head, __global const int *deep_next,                          \
+        __global const uint *deep_counts
 
 typedef struct ShadowRay {
     int texel; /* map texel of the last lookup, -1 before the first */
@@ -802,7 +804,7 @@ inline deep_node deep_fetch(__global const deep_node *nodes, int fixed, size_t t
     return nodes[((size_t)block * K + (size_t)((uint)j % K)) * T2 + (size_t)lane];
 }
 
-inline float3 deep_shadow(__global const UmbraShadow *S, VolGeom g,
+inline float3 deep_shadow(__global const UmbraShadow *S, __global const UmbraDeep *D, VolGeom g,
                           __global const deep_node *nodes, __global const int *head,
                           __global const int *next, __global const uint *counts, ShadowRay *sr,
                           float3 p)
@@ -816,15 +818,15 @@ inline float3 deep_shadow(__global const UmbraShadow *S, VolGeom g,
         return (float3)(1.0f);
     const int n = (int)S->map_size;
     const int idx = t.y * n + t.x;
-    const int fixed = S->max_nodes > 0u;
-    const uint K = S->block_size;
+    const int fixed = D->max_nodes > 0u;
+    const uint K = D->block_size;
     /* The tile is a power of two (host/techniques/deep.c): shifts and masks, not four divisions. */
-    const int T = (int)S->deep_tile, shift = 31 - (int)clz((uint)T);
+    const int T = (int)D->tile, shift = 31 - (int)clz((uint)T);
     const size_t T2 = (size_t)(T * T);
-    const int tile = (t.y >> shift) * (int)S->tiles_per_row + (t.x >> shift);
+    const int tile = (t.y >> shift) * (int)D->tiles_per_row + (t.x >> shift);
     const int lane = ((t.y & (T - 1)) << shift) + (t.x & (T - 1));
-    const size_t base = (size_t)idx * S->max_nodes;
-    const int count = fixed ? (int)S->max_nodes : (int)counts[idx];
+    const size_t base = (size_t)idx * D->max_nodes;
+    const int count = fixed ? (int)D->max_nodes : (int)counts[idx];
     const float d = m.z;
     if (count <= 0)
         return (float3)(1.0f);
@@ -866,4 +868,4 @@ inline float3 deep_shadow(__global const UmbraShadow *S, VolGeom g,
 }
 
 #define SHADOW_FACTOR(sr, p)                                                                   \
-    deep_shadow(S, g, deep_nodes, deep_head, deep_next, deep_counts, &(sr), (p))
+    deep_shadow(S, D, g, deep_nodes, deep_head, deep_next, deep_counts, &(sr), (p))

@@ -206,7 +206,8 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
                                __global const float4 *view_tf, __global const float4 *light_tf,
                                __global const uchar *view_bricks,
                                __global const ulong *light_cells, __global const UmbraShadow *S,
-                               __global const deep_node *lut, uint use_lut, float eps,
+                               __global const UmbraDeep *D, __global const deep_node *lut,
+                               uint use_lut, float eps,
                                __global deep_node *out)
 {
     (void)view_tf;
@@ -215,7 +216,7 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
     const int gx = (int)get_global_id(0), gy = (int)get_global_id(1);
     if (gx >= n || gy >= n)
         return;
-    const int N = (int)S->max_nodes;
+    const int N = (int)D->max_nodes;
     const VolGeom g = vol_geom(F);
     __global deep_node *o = out + (size_t)(gy * n + gx) * (size_t)N;
     DeepTexel st;

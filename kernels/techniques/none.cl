@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 /* kernels/techniques/none.cl: the "none" shadow technique: every point is fully lit.
  *
- * The shadow-technique interface, which every kernels/shadow_*.cl file implements:
+ * The shadow-technique interface, which every technique's kernels/techniques/<name>.cl implements
+ * (host/renderer_internal.h lists its kernel files; its constants, if any, are a struct in
+ * kernels/techniques/<name>_shared.h that SHADOW_KERNEL_PARAMS takes and its bind function
+ * passes):
  *   SHADOW_KERNEL_PARAMS    extra kernel parameters, each with a leading comma (may be empty);
  *                           the host module binds them after the fixed raycast arguments
  *   ShadowRay               per-view-ray state (e.g. where the last lookup ended)

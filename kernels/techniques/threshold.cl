@@ -3,10 +3,10 @@
  * where a thresholding at opacity 0.5 is applied", as the CSSM paper compares against).
  *
  * threshold_build marches each texel's light ray (through the texel centre) and stores the
- * normalised depth where the accumulated opacity first exceeds S->threshold, or LS_DEPTH_NEVER.
+ * normalised depth where the accumulated opacity first exceeds P->threshold, or LS_DEPTH_NEVER.
  * Only the light transfer function's opacity counts: the map holds one depth, so it cannot carry
  * colour and ignores the transmission colour. The lookup tests a sample against that depth:
- * shadowed (0) beyond it, lit (1) before; with S->taps > 1 it averages the tests at the CSSM tap
+ * shadowed (0) beyond it, lit (1) before; with P->taps > 1 it averages the tests at the CSSM tap
  * offsets (PCF), so that its softness compares fairly with CSSM's.
  *
  * The march: whole steps of S->step plus one partial step, each sampled at its midpoint, its
@@ -18,7 +18,7 @@
  * the transmittance 1 - A of the whole segments as a product, not A (the same test and crossing
  * up to rounding, without a logarithm or an exponential per segment: see the kernel). */
 
-#define SHADOW_KERNEL_PARAMS , __global const float *shadow_map
+#define SHADOW_KERNEL_PARAMS , __global const UmbraThreshold *P, __global const float *shadow_map
 
 typedef struct ShadowRay {
     int unused;
@@ -30,7 +30,7 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
                               __global const float4 *view_tf, __global const float4 *light_tf,
                               __global const uchar *view_bricks,
                               __global const ulong *light_cells, __global const UmbraShadow *S,
-                              __global float *map)
+                              __global const UmbraThreshold *P, __global float *map)
 {
     const int x = get_global_id(0), y = get_global_id(1);
     const int n = (int)S->map_size;
@@ -43,7 +43,7 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
     const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
     float depth = LS_DEPTH_NEVER;
     if (tb.y > tb.x) {
-        const float h = S->step, thr = S->threshold, h_vox = light_step_voxels(F, S);
+        const float h = S->step, thr = P->threshold, h_vox = light_step_voxels(F, S);
         const uint n_tf = F->light_tf_size;
         const int skip = (F->flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         const float len = tb.y - tb.x;
@@ -105,15 +105,16 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
 }
 
 /* Fraction of the taps around p's texel whose stored depth p does not lie beyond. */
-UMBRA_INLINE float threshold_lookup(__global const UmbraShadow *S, __global const float *map,
+UMBRA_INLINE float threshold_lookup(__global const UmbraShadow *S,
+                                    __global const UmbraThreshold *P, __global const float *map,
                                     float3 p)
 {
     const float3 m = ls_world_to_map(S, p);
     int2 base;
     if (!ls_base_texel(S, m.xy, &base))
         return 1.0f;
-    const uint taps = S->taps;
-    const float s = m.z - S->depth_bias;
+    const uint taps = P->taps;
+    const float s = m.z - P->depth_bias;
     const int n = (int)S->map_size;
     float lit = 0.0f;
     if (ls_taps_inside(n, base)) {
@@ -129,4 +130,4 @@ UMBRA_INLINE float threshold_lookup(__global const UmbraShadow *S, __global cons
     return lit / (float)taps;
 }
 
-#define SHADOW_FACTOR(sr, p) ((float3)(threshold_lookup(S, shadow_map, (p))))
+#define SHADOW_FACTOR(sr, p) ((float3)(threshold_lookup(S, P, shadow_map, (p))))

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Pictures for a Jupyter notebook: umbra renders to a NumPy array; to_uint8() makes it displayable
-(matplotlib's imshow, PIL.Image.fromarray) and show() returns a PIL image, which Jupyter draws
-inline as the cell's value.
+"""Pictures for a Jupyter notebook: umbra renders to a NumPy array; umbra.to_srgb8() makes it
+displayable (matplotlib's imshow, PIL.Image.fromarray) and show() returns a PIL image, which
+Jupyter draws inline as the cell's value.
 
     from notebook import render_scene, show
     img = render_scene("spheres", technique="reference")   # (240, 320, 4) float32
@@ -17,6 +17,7 @@ import sys
 import numpy as np
 
 import umbra
+from umbra import to_srgb8
 
 
 def render_scene(name="spheres", technique="reference", width=320, height=240, ctx=None,
@@ -34,18 +35,10 @@ def render_scene(name="spheres", technique="reference", width=320, height=240, c
             return r.render(width, height, technique=technique, **params)
 
 
-def to_uint8(rgba):
-    """Linear premultiplied RGBA floats -> 8-bit sRGB RGBA (un-premultiplied), as umbra's PNGs."""
-    a = np.clip(rgba[..., 3:4], 0.0, 1.0)
-    rgb = np.where(a > 0, rgba[..., :3] / np.maximum(a, 1e-12), 0.0).clip(0.0, 1.0)
-    srgb = np.where(rgb <= 0.0031308, 12.92 * rgb, 1.055 * rgb ** (1 / 2.4) - 0.055)
-    return (np.concatenate([srgb, a], axis=-1) * 255 + 0.5).astype(np.uint8)
-
-
 def show(rgba):
     """A PIL image of the render (Jupyter displays it inline)."""
     from PIL import Image
-    return Image.fromarray(to_uint8(rgba), "RGBA")
+    return Image.fromarray(to_srgb8(rgba), "RGBA")
 
 
 if __name__ == "__main__":

@@ -6,18 +6,15 @@
     python render_nifti.py ct.nii.gz ct.png --tf ../../examples/presets/ct_bone.json
     python render_nifti.py --make-demo demo.nii.gz     # writes a small synthetic CT-like volume
 
-nibabel hands the voxels over as an (x, y, z) array in Fortran order, i.e. x varying fastest in
-memory, which is umbra's layout: its transpose is the C-contiguous (z, y, x) array umbra.Volume
-takes, so the voxels go to the device without a copy in Python. A scaled image (scl_slope) is
-read as float32 instead.
-
-The volume is placed in the file's world (RAS+, millimetres) by its affine A, which maps a voxel
-index (i, j, k) = (x, y, z) to A @ (i, j, k, 1). umbra takes it apart as umbra's own NIfTI loader
-does: spacing[a] = |A[:3, a]| (column a is index axis a), origin = A[:3, 3] (voxel (0, 0, 0)'s
-centre) and directions[a] = A[:3, a] / spacing[a], i.e. directions = (A[:3, :3] / spacing).T,
-whose ROWS are the axes: the transposition turns nibabel's columns into umbra's rows. The
-directions must be at right angles (a sheared affine raises umbra.Error ERROR_UNSUPPORTED). The
-camera orbits the box's world centre, volume.info.center. Ctrl-C stops a long render cleanly.
+umbra.Volume.from_nibabel takes the image as nibabel reads it: the voxels of its dataobj (an
+(x, y, z) array in Fortran order, i.e. x varying fastest in memory, which is umbra's layout, so
+its transpose goes to the device without a copy in Python; a scaled image, with scl_slope or
+scl_inter, comes as float64 and is converted to float32 once) and the placement in the file's
+world (RAS+, millimetres) by its affine A, which maps a voxel index (i, j, k) = (x, y, z) to
+A @ (i, j, k, 1), as umbra's own NIfTI loader does (the README's "Python" section spells the
+mapping out). The camera orbits the box's world centre, volume.info.center. The picture is
+written by umbra where it has image I/O, else (the wheel) as a PNG through Pillow with
+umbra.to_srgb8. Ctrl-C stops a long render cleanly.
 """
 import argparse
 import sys
@@ -49,23 +46,17 @@ def make_demo(path, n=64):
     nib.save(img, path)
 
 
-def load_nifti(path):
-    """(z, y, x) array for umbra and the placement: spacing (x, y, z), origin, directions."""
-    img = nib.load(path)
-    if img.ndim != 3:
-        raise SystemExit(f"{path}: {img.ndim}-D image; a 3-D volume is needed")
-    scaled = img.dataobj.slope != 1 or img.dataobj.inter != 0
-    data = np.asanyarray(img.dataobj) if not scaled else img.get_fdata(dtype=np.float32)
-    if data.dtype not in (np.uint8, np.uint16, np.int16, np.float32):
-        data = data.astype(np.float32)
-    # Fortran (x, y, z) -> C-contiguous (z, y, x) without copying; anything else is copied once.
-    zyx = np.ascontiguousarray(data.T)
-    A = img.affine
-    # rounded to float32 before dividing, as umbra's loader does: the same numbers as umbra-render
-    spacing = np.linalg.norm(A[:3, :3], axis=0).astype(np.float32)
-    origin = tuple(float(v) for v in A[:3, 3])
-    directions = (A[:3, :3] / spacing).T          # row a: the world direction of index axis a
-    return zyx, tuple(float(v) for v in spacing), origin, directions
+def save(ctx, out, img):
+    """Writes the render: .png or .exr through umbra, or a .png through Pillow where this umbra
+    has no image I/O (the wheel)."""
+    if umbra.has_image_io:
+        ctx.write_image(out, img)
+        return
+    if not out.lower().endswith(".png"):
+        raise SystemExit(f"{out}: this umbra writes no images itself; give a .png name "
+                         "(written through Pillow)")
+    from PIL import Image
+    Image.fromarray(umbra.to_srgb8(img), "RGBA").save(out)
 
 
 def show_progress(fraction):
@@ -75,16 +66,15 @@ def show_progress(fraction):
 
 def render(path, out, technique="cssm", size=(512, 512), light=(0.45, -1.0, 0.25), tf_path=None,
            **params):
-    zyx, spacing, origin, directions = load_nifti(path)
-    lo, hi = np.percentile(zyx, [1, 99.9])
+    image = nib.load(path)
     with umbra.Context() as ctx:
         if tf_path:
             # a ParaView preset (or umbra's text format); a preset spans data values, e.g. HU
-            vol = umbra.Volume(ctx, zyx, spacing=spacing, origin=origin, directions=directions)
+            vol = umbra.Volume.from_nibabel(ctx, image)
             tf = ctx.load_transfer_function(tf_path)
         else:
-            vol = umbra.Volume(ctx, zyx, spacing=spacing, origin=origin, directions=directions,
-                               value_range=(float(lo), float(hi)))
+            lo, hi = np.percentile(np.asanyarray(image.dataobj), [1, 99.9])
+            vol = umbra.Volume.from_nibabel(ctx, image, value_range=(float(lo), float(hi)))
             # low values clear, mid values faint and warm, the densest white and opaque
             tf = umbra.TransferFunction.from_points(ctx, [
                 (0.00, 0.0, 0.0, 0.0, 0.0),
@@ -107,7 +97,7 @@ def render(path, out, technique="cssm", size=(512, 512), light=(0.45, -1.0, 0.25
             s = r.stats
             print(f"{technique}: shadow build {s.shadow_build_ms:.1f} ms, render "
                   f"{s.render_ms:.1f} ms, {s.shadow_memory_bytes / 2**20:.1f} MiB", file=sys.stderr)
-        ctx.write_image(out, img)
+        save(ctx, out, img)
     return img
 
 

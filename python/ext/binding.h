@@ -51,6 +51,9 @@ extern PyObject *error_type;
 void check(umbra_context ctx, umbra_status st);
 /* ValueError, as for a closed file. */
 [[noreturn]] void raise_closed(const char *what);
+/* path as a C string, or ValueError naming what ("umbra.Context.load_volume: path") when it holds
+ * a NUL character, at which C would cut it ("a.png\x00.txt" would write a.png). */
+const char *path_arg(const std::string &path, const char *what);
 
 /* ---- arrays (support.cpp) ---------------------------------------------------------------------- */
 
@@ -133,6 +136,14 @@ template <class T> void apply_kwargs(T &d, const nb::kwargs &kw, const char *wha
     }
 }
 
+/* A ShadowOptions' keyword arguments: the technique first (a key means the current technique's
+ * parameter where it has one), then the parameters. `preintegrated`, a ShadowOptions field until
+ * umbra 0.4 and a RenderOptions one since, goes to *preintegrated (-1 when not given) where the
+ * caller takes it (Renderer.set_shadow, render), else is refused with a TypeError saying where it
+ * went (options.cpp). */
+void apply_shadow_kwargs(umbra_shadow_desc &d, const nb::kwargs &kw, const char *what,
+                         int *preintegrated = nullptr);
+
 /* ---- the object wrappers ------------------------------------------------------------------------ */
 
 struct Context {
@@ -196,9 +207,24 @@ struct Renderer {
      * error indicator to be raised when the C call returns. */
     nb::object progress = nb::none();
     bool python_error = false;
-    /* True during a C call that reports progress: the callable must not use this renderer (the C
-     * renderer is in the middle of the call), so get() and close() refuse. */
+    /* True during a C call that reports progress, made on thread busy_thread (Python's thread
+     * ident): neither the callable nor another thread (which runs while the callable runs Python
+     * code) may use this renderer then (the C renderer is in the middle of the call), so get()
+     * and close() refuse, saying which of the two it is. */
     bool busy = false;
+    unsigned long busy_thread = 0;
+    /* The refusal: RuntimeError naming what was attempted (what: "used", "closed"). */
+    [[noreturn]] void refuse_busy(const char *what) const
+    {
+        if (busy_thread == PyThread_get_thread_ident())
+            throw std::runtime_error(std::string("umbra.Renderer: ") + what +
+                                     " from its own progress callback, which must not call the "
+                                     "renderer it reports on");
+        throw std::runtime_error(std::string("umbra.Renderer: ") + what +
+                                 " while another thread renders with it (a renderer is used by "
+                                 "one thread at a time: give each thread its own, or hold a lock "
+                                 "around its calls)");
+    }
     Renderer() = default;
     Renderer(const Renderer &) = delete;
     ~Renderer() { close(); }
@@ -213,8 +239,7 @@ struct Renderer {
     umbra_renderer get() const
     {
         if (busy)
-            throw std::runtime_error("umbra.Renderer: used from its own progress callback, "
-                                     "which must not call the renderer it reports on");
+            refuse_busy("used");
         if (!h)
             raise_closed("Renderer");
         return h;

@@ -5,6 +5,7 @@
  * them); a transfer function from a table or control points, optionally over a data range, or
  * from a ParaView preset. Split from objects.cpp (Context, Renderer, Scene) to keep each file
  * readable. */
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -20,20 +21,179 @@ namespace
 using vec3 = std::array<float, 3>;
 using range_t = std::pair<float, float>;
 
-/* The scalar type of a NumPy dtype, or a clear error naming the supported ones. */
-umbra_scalar_type scalar_type_of(nb::dlpack::dtype t)
+/* ---- voxel types ----------------------------------------------------------------------------
+ * umbra stores uint8, uint16, int16 and float32; an array of one of them is read in place. Any
+ * other real, integer or bool array is converted once into the nearest of them (the rule the
+ * Volume docstring and the README state): bool -> uint8 (read in place); float16 and float64 ->
+ * float32; every other integer type -> the first of uint8, uint16, int16 that holds all its
+ * values, else float32. The conversion writes through umbra_volume_create_filled: on a CPU device
+ * straight into the device's mapped buffer, elsewhere into the host buffer umbra uploads from:
+ * no copy is made here. */
+
+using convert_fn = void (*)(const void *src, size_t n, void *dst);
+
+struct voxels {
+    umbra_scalar_type type = UMBRA_FLOAT32;
+    const void *data = nullptr;  /* read in place, or the source of convert */
+    size_t count = 0;
+    convert_fn convert = nullptr; /* null: in place */
+    umbra_context ctx = nullptr;
+};
+
+template <class T, class S> void cast_all(const void *src, size_t n, void *dst)
 {
-    if (t == nb::dtype<uint8_t>())
-        return UMBRA_UINT8;
-    if (t == nb::dtype<uint16_t>())
-        return UMBRA_UINT16;
-    if (t == nb::dtype<int16_t>())
-        return UMBRA_INT16;
-    if (t == nb::dtype<float>())
-        return UMBRA_FLOAT32;
-    raise_invalid("umbra.Volume: dtype " + dtype_name(t) +
-                  " is not supported; use uint8, uint16, int16 or float32 "
-                  "(e.g. data.astype(numpy.float32))");
+    const S *in = static_cast<const S *>(src);
+    T *out = static_cast<T *>(dst);
+    for (size_t i = 0; i < n; ++i)
+        out[i] = static_cast<T>(in[i]);
+}
+
+/* Integers into the narrowest stored type that keeps every value exactly, else float32
+ * (exact up to 2^24 in magnitude, rounded to nearest beyond). */
+template <class S> void from_integers(voxels &v, const S *src, size_t n)
+{
+    S lo = n ? src[0] : 0, hi = lo;
+    for (size_t i = 1; i < n; ++i) {
+        lo = src[i] < lo ? src[i] : lo;
+        hi = src[i] > hi ? src[i] : hi;
+    }
+    /* Compared as long double so that uint64 and int64 bounds compare exactly. */
+    long double l = (long double)lo, h = (long double)hi;
+    if (l >= 0 && h <= UINT8_MAX)
+        v.type = UMBRA_UINT8, v.convert = cast_all<uint8_t, S>;
+    else if (l >= 0 && h <= UINT16_MAX)
+        v.type = UMBRA_UINT16, v.convert = cast_all<uint16_t, S>;
+    else if (l >= INT16_MIN && h <= INT16_MAX)
+        v.type = UMBRA_INT16, v.convert = cast_all<int16_t, S>;
+    else
+        v.type = UMBRA_FLOAT32, v.convert = cast_all<float, S>;
+}
+
+/* IEEE half to float, exactly (infinities and NaN carried, for umbra_volume_create to name). */
+float half_to_float(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h & 0x8000u) << 16, exp = (h >> 10) & 0x1fu, man = h & 0x3ffu;
+    if (exp == 0) { /* zero or subnormal: man * 2^-24, exact in float */
+        float f = (float)man * 5.9604645e-8f;
+        return sign ? -f : f;
+    }
+    uint32_t bits = sign | (exp == 31 ? 0x7f800000u : (exp + 112u) << 23) | man << 13;
+    float f;
+    std::memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+void halves_to_floats(const void *src, size_t n, void *dst)
+{
+    for (size_t i = 0; i < n; ++i)
+        static_cast<float *>(dst)[i] = half_to_float(static_cast<const uint16_t *>(src)[i]);
+}
+
+/* float64 becomes float32 rounded to nearest; a finite value past float32's range is refused
+ * first, naming it (NaN and infinities go on to umbra_volume_create, which names them). */
+void check_float32_range(const double *src, size_t n, const uint32_t dims[3])
+{
+    for (size_t i = 0; i < n; ++i) {
+        double d = src[i];
+        if (std::isfinite(d) && std::fabs(d) > FLT_MAX) {
+            size_t x = i % dims[0], y = i / dims[0] % dims[1], z = i / dims[0] / dims[1];
+            char value[32];
+            std::snprintf(value, sizeof value, "%g", d);
+            raise_invalid("umbra.Volume: voxel " + std::to_string(i) + " (x " +
+                          std::to_string(x) + ", y " + std::to_string(y) + ", z " +
+                          std::to_string(z) + ") is " + value +
+                          ", beyond float32's range (3.4e38): scale the data first");
+        }
+    }
+}
+
+/* How the voxels of a C-contiguous 3-D array reach umbra, or umbra.Error naming the dtype. */
+voxels stored_voxels(const any_array &a, const uint32_t dims[3])
+{
+    nb::dlpack::dtype t = a.dtype();
+    voxels v;
+    v.data = a.data();
+    v.count = a.size();
+    const void *p = v.data;
+    size_t n = v.count;
+    if (t == nb::dtype<uint8_t>() || t == nb::dtype<bool>())
+        v.type = UMBRA_UINT8; /* a NumPy bool is one byte, 0 or 1 */
+    else if (t == nb::dtype<uint16_t>())
+        v.type = UMBRA_UINT16;
+    else if (t == nb::dtype<int16_t>())
+        v.type = UMBRA_INT16;
+    else if (t == nb::dtype<float>())
+        v.type = UMBRA_FLOAT32;
+    else if (t == nb::dtype<int8_t>())
+        from_integers(v, (const int8_t *)p, n);
+    else if (t == nb::dtype<int32_t>())
+        from_integers(v, (const int32_t *)p, n);
+    else if (t == nb::dtype<uint32_t>())
+        from_integers(v, (const uint32_t *)p, n);
+    else if (t == nb::dtype<int64_t>())
+        from_integers(v, (const int64_t *)p, n);
+    else if (t == nb::dtype<uint64_t>())
+        from_integers(v, (const uint64_t *)p, n);
+    else if (t == nb::dtype<double>()) {
+        check_float32_range((const double *)p, n, dims);
+        v.type = UMBRA_FLOAT32, v.convert = cast_all<float, double>;
+    } else if (t.code == (uint8_t)nb::dlpack::dtype_code::Float && t.bits == 16 && t.lanes == 1)
+        v.type = UMBRA_FLOAT32, v.convert = halves_to_floats;
+    else
+        raise_invalid("umbra.Volume: dtype " + dtype_name(t) +
+                      " is not supported; pass a real, integer or bool array (uint8, uint16, "
+                      "int16 and float32 are read in place, others converted)");
+    return v;
+}
+
+umbra_status fill_converted(void *user, void *dst, size_t bytes)
+{
+    const voxels *v = static_cast<const voxels *>(user);
+    if (bytes != v->count * umbra_scalar_type_size(v->type))
+        return umbra_context_record_error(v->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                          "umbra.Volume: the volume asks for a different number "
+                                          "of bytes than the array converts to");
+    v->convert(v->data, v->count, dst);
+    return UMBRA_SUCCESS;
+}
+
+/* A NumPy array nanobind cannot view, of another byte order (a big-endian file's voxels, as
+ * nibabel hands them over) or of long double, made native by NumPy first (float64 for long
+ * double): one host copy, which a byte swap needs anyway. The layout is kept (order "K"), so a
+ * strided array is still refused as such. Anything else is returned as it is. */
+nb::object numpy_native(nb::handle data)
+{
+    nb::object dt = nb::getattr(data, "dtype", nb::none());
+    if (dt.is_none() || !nb::hasattr(data, "astype") || !nb::hasattr(dt, "kind"))
+        return nb::borrow(data);
+    std::string kind = nb::cast<std::string>(nb::str(dt.attr("kind")));
+    if (kind.size() != 1 || !std::strchr("biuf", kind[0]))
+        return nb::borrow(data);
+    if (kind == "f" && nb::cast<size_t>(dt.attr("itemsize")) > 8)
+        return data.attr("astype")("float64", "order"_a = "K");
+    if (!nb::cast<bool>(dt.attr("isnative")))
+        return data.attr("astype")(dt.attr("newbyteorder")("="), "order"_a = "K");
+    return nb::borrow(data);
+}
+
+/* The image objects Volume.from_nibabel, from_sitk and from_vtk read (by their type's module),
+ * refused by the constructor with the method that carries their placement too. */
+void refuse_image_object(nb::handle data)
+{
+    nb::object mod = nb::getattr(data.type(), "__module__", nb::none());
+    std::string m = nb::isinstance<nb::str>(mod) ? nb::cast<std::string>(mod) : "";
+    auto from = [&](const char *prefix) { return m.compare(0, std::strlen(prefix), prefix) == 0; };
+    const char *use = nullptr;
+    if (from("nibabel"))
+        use = "from_nibabel";
+    else if (from("SimpleITK"))
+        use = "from_sitk";
+    else if (from("vtkmodules") || from("pyvista"))
+        use = "from_vtk";
+    if (use)
+        raise_invalid(std::string("umbra.Volume: data is a ") + nb::type_name(data.type()).c_str() +
+                      "; use umbra.Volume." + use +
+                      "(context, image), which also takes its spacing, origin and direction");
 }
 
 /* NaN and infinite float voxels are refused by umbra_volume_create itself (naming the first one),
@@ -43,10 +203,14 @@ Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<ra
                    std::optional<std::array<vec3, 3>> directions)
 {
     umbra_context c = ctx.get();
-    any_array a = as_array(data, "umbra.Volume: data");
+    refuse_image_object(data);
+    any_array a;
+    nb::object held = nb::borrow(data); /* alive until the voxels are on the device */
+    if (!nb::try_cast(data, a, false))
+        held = numpy_native(data);
+    a = as_array(held, "umbra.Volume: data");
     umbra_volume_desc d;
     umbra_volume_desc_init(&d);
-    d.type = scalar_type_of(a.dtype());
     if (a.ndim() != 3)
         raise_invalid("umbra.Volume: data has shape " + shape_text(a) +
                       "; need a 3-D array of shape (z, y, x)");
@@ -60,7 +224,10 @@ Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<ra
         d.dims[i] = (uint32_t)n;
         d.spacing[i] = spacing[i];
     }
-    d.data = a.data();
+    voxels vox = stored_voxels(a, d.dims);
+    vox.ctx = c;
+    d.type = vox.type;
+    d.data = vox.convert ? nullptr : vox.data;
     if (value_range) {
         d.value_range_given = 1;
         d.value_min = value_range->first;
@@ -79,7 +246,8 @@ Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<ra
         }
     }
     umbra_volume v = nullptr;
-    check(c, umbra_volume_create(c, &d, &v));
+    check(c, vox.convert ? umbra_volume_create_filled(c, &d, fill_converted, &vox, &v)
+                         : umbra_volume_create(c, &d, &v));
     return Volume(c, v);
 }
 
@@ -122,8 +290,18 @@ TransferFunction load_paraview(Context &ctx, const std::string &path,
         o.range_max = range->second;
     }
     umbra_transfer_function t = nullptr;
-    check(c, umbra_transfer_function_load_paraview(c, path.c_str(), &o, &t, nullptr));
+    check(c, umbra_transfer_function_load_paraview(
+                 c, path_arg(path, "umbra.TransferFunction.load_paraview: path"), &o, &t, nullptr));
     return TransferFunction(c, t);
+}
+
+/* Volume.from_* are written in Python (umbra/_adapters.py): they read the other libraries'
+ * objects through those libraries and end in the Volume constructor. */
+auto adapter(const char *name)
+{
+    return [name](nb::args args, nb::kwargs kwargs) {
+        return nb::module_::import_("umbra._adapters").attr(name)(*args, **kwargs);
+    };
 }
 
 void bind_data(nb::module_ &m)
@@ -133,9 +311,18 @@ void bind_data(nb::module_ &m)
     umbra_volume_desc_init(&volume_defaults);
     nb::class_<Volume>(
         m, "Volume",
-        "A scalar volume on the device (umbra_volume). Built from a C-contiguous NumPy array of "
-        "shape (z, y, x) (x varies fastest, as in umbra), dtype uint8, uint16, int16 or float32; "
-        "the array is read in place and copied once, to the device. Float voxels must be finite.")
+        "A scalar volume on the device (umbra_volume). Built from a C-contiguous array of shape "
+        "(z, y, x) (x varies fastest, as in umbra) of any real, integer or bool dtype. uint8, "
+        "uint16, int16 and float32 are stored as they are: the array is read in place and "
+        "copied once, to the device. Any other dtype is converted once into the nearest of "
+        "them, on the way to the device (umbra_volume_create_filled: on a CPU device straight "
+        "into the device's buffer, elsewhere into a host buffer freed before return): bool -> "
+        "uint8 (read in place); float16, float64 -> float32 (a finite value beyond float32's "
+        "range is refused); int8, int32, uint32, int64, uint64 -> the first of uint8, uint16, "
+        "int16 that holds every value, else float32 (exact up to 2^24); a big-endian or long "
+        "double array is first made native by NumPy (long double as float64). Float voxels "
+        "must be finite. From nibabel, SimpleITK or VTK/pyvista images: Volume.from_nibabel, from_sitk, "
+        "from_vtk.")
         .def(
             "__init__",
             [](Volume *self, Context &ctx, nb::handle data, vec3 spacing,
@@ -163,6 +350,26 @@ void bind_data(nb::module_ &m)
             "directions the identity); neither: the box is centred on the world origin. From a "
             "NIfTI affine A (nibabel's img.affine, index (i, j, k) = (x, y, z)): spacing = "
             "|A[:3, a]| per column a, origin = A[:3, 3], directions = (A[:3, :3] / spacing).T.")
+        .def_static("from_nibabel", adapter("from_nibabel"),
+                    nb::sig("def from_nibabel(context: Context, image: object, /, "
+                            "**kwargs: object) -> Volume"),
+                    "A nibabel image (NIfTI, MGH, ...: anything with dataobj and affine), "
+                    "scaled by its scl_slope/scl_inter as nibabel reads it, placed by its affine "
+                    "(RAS+). 3-D, or with every axis past the third of size 1. kwargs: "
+                    "value_range, brick_size, as for Volume().")
+        .def_static("from_sitk", adapter("from_sitk"),
+                    nb::sig("def from_sitk(context: Context, image: object, /, "
+                            "**kwargs: object) -> Volume"),
+                    "A 3-D scalar SimpleITK.Image with its spacing, origin and direction (ITK's "
+                    "physical space, LPS). kwargs: value_range, brick_size.")
+        .def_static("from_vtk", adapter("from_vtk"),
+                    nb::sig("def from_vtk(context: Context, image: object, /, "
+                            "array: str | None = None, **kwargs: object) -> Volume"),
+                    "A vtkImageData or pyvista.ImageData with its spacing, origin, direction "
+                    "matrix and extent. array: the name of a one-component point- or "
+                    "cell-data array (None: the active point scalars, else the only point "
+                    "array, else the same for cell data; cell data are voxels centred in the "
+                    "cells). kwargs: value_range, brick_size.")
         .def("close", &Volume::close, "Drops this object's reference; idempotent.")
         .def_prop_ro("closed", [](const Volume &v) { return v.h == nullptr; })
         .def(

@@ -33,15 +33,17 @@ NB_MODULE(_umbra, m)
         .value("ERROR_CANCELLED", UMBRA_ERROR_CANCELLED,
                "the progress callback asked to stop; the renderer stays usable");
 
-    nb::enum_<umbra_shadow_technique>(m, "Technique",
-                                      "umbra_shadow_technique; keyword arguments "
-                                      "also take the CLI's names ('cssm').")
-        .value("NONE", UMBRA_SHADOW_NONE, "no shadows")
-        .value("REFERENCE", UMBRA_SHADOW_REFERENCE, "exact: a shadow ray from every sample")
-        .value("THRESHOLD", UMBRA_SHADOW_THRESHOLD, "opacity-threshold shadow map")
-        .value("DEEP", UMBRA_SHADOW_DEEP, "deep shadow map (Hadwiger et al. 2006)")
-        .value("CSSM", UMBRA_SHADOW_CSSM, "colored stochastic shadow map (Weidner & Linsen)")
-        .value("CONVOLUTION", UMBRA_SHADOW_CONVOLUTION, "slice-based convolution shadows");
+    /* One value per technique of the registry (umbra/registry.h), its name in capitals. */
+    nb::enum_<umbra_shadow_technique> technique(m, "Technique",
+                                                "umbra_shadow_technique; keyword arguments "
+                                                "also take the CLI's names ('cssm').");
+    static std::vector<std::string> technique_names(umbra_technique_count());
+    for (uint32_t i = 0; i < umbra_technique_count(); ++i) {
+        const umbra_technique_info *t = umbra_technique_get(i);
+        for (const char *c = t->name; *c; ++c)
+            technique_names[i] += (char)std::toupper((unsigned char)*c);
+        technique.value(technique_names[i].c_str(), t->id, t->title);
+    }
 
     nb::enum_<umbra_transmission>(m, "Transmission", "umbra_transmission")
         .value("GREY", UMBRA_TRANSMISSION_GREY, "every channel attenuated by the opacity alone")
@@ -70,6 +72,9 @@ NB_MODULE(_umbra, m)
     m.attr("Error") = nb::steal(error_type);
 
     m.attr("MAP_SIZE_AUTO") = UMBRA_MAP_SIZE_AUTO;
+    /* Set by python/CMakeLists.txt from UMBRA_IO_IMAGES: the wheel is built without
+     * OpenImageIO. */
+    m.attr("has_image_io") = nb::bool_(UMBRA_PY_IMAGE_IO != 0);
 
     m.def(
         "version", []() { return std::string(umbra_version()); },

@@ -8,7 +8,8 @@
  * life: it runs the Python progress callable, if any, and checks for signals, so that Ctrl-C
  * cancels a long render between two bands of device work and surfaces as KeyboardInterrupt. The
  * GIL stays held during renders: the callback runs on the calling thread and may call Python
- * directly, and no other Python thread can reach the (single-threaded) C renderer meanwhile. */
+ * directly. Other Python threads run only while the callable runs Python code; one that reaches
+ * the renderer then is refused (Renderer::refuse_busy), as the callable itself is. */
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -33,6 +34,22 @@ void renderer_set_options(Renderer &r, const umbra_render_desc &d)
 {
     check(r.ctx, umbra_renderer_set_options(r.get(), &d));
     r.options = d;
+}
+
+/* set_shadow(**params) and render(**params): a ShadowOptions from the C defaults and params;
+ * `preintegrated`, a render option since umbra 0.5, is kept as a keyword and sets the options. */
+void renderer_set_shadow_kwargs(Renderer &r, const nb::kwargs &kw, const char *what)
+{
+    umbra_shadow_desc d;
+    umbra_shadow_desc_init(&d);
+    int preintegrated;
+    apply_shadow_kwargs(d, kw, what, &preintegrated);
+    if (preintegrated >= 0) {
+        umbra_render_desc o = r.options;
+        o.preintegrated = preintegrated;
+        renderer_set_options(r, o);
+    }
+    renderer_set_shadow(r, d);
 }
 
 void renderer_set_volume(Renderer &r, nb::handle v)
@@ -87,7 +104,14 @@ int on_progress(void *user, float fraction)
     try {
         nb::object f = r.progress; /* the callable may replace itself */
         nb::object res = f(py_float(fraction));
-        return PyObject_IsTrue(res.ptr()) == 1 ? 1 : 0;
+        /* Truth-testing the result runs Python (__bool__, __len__) and may raise: that exception
+         * cancels like the callable's own. */
+        int cancel = PyObject_IsTrue(res.ptr());
+        if (cancel < 0) {
+            r.python_error = true;
+            return 1;
+        }
+        return cancel;
     } catch (nb::python_error &e) {
         e.restore();
         r.python_error = true;
@@ -127,7 +151,11 @@ PyType_Slot renderer_slots[] = {{Py_tp_traverse, (void *)renderer_traverse},
 /* Marks a renderer busy for the length of a C call that reports progress. */
 struct Busy {
     Renderer &r;
-    explicit Busy(Renderer &rr) : r(rr) { r.busy = true; }
+    explicit Busy(Renderer &rr) : r(rr)
+    {
+        r.busy = true;
+        r.busy_thread = PyThread_get_thread_ident();
+    }
     ~Busy() { r.busy = false; }
     Busy(const Busy &) = delete;
 };
@@ -135,8 +163,7 @@ struct Busy {
 void renderer_close(Renderer &r)
 {
     if (r.busy)
-        throw std::runtime_error("umbra.Renderer: closed from its own progress callback, "
-                                 "which must not call the renderer it reports on");
+        r.refuse_busy("closed");
     r.close();
 }
 
@@ -176,7 +203,8 @@ void bind_objects(nb::module_ &m)
                 d.platform_index = platform_index;
                 d.device_index = device_index;
                 d.sampler = enum_from<umbra_sampler_kind>(sampler);
-                d.cache_dir = cache_dir ? cache_dir->c_str() : nullptr;
+                d.cache_dir =
+                    cache_dir ? path_arg(*cache_dir, "umbra.Context: cache_dir") : nullptr;
                 d.use_environment = use_environment;
                 std::string message;
                 d.error_callback = [](void *user, umbra_status, const char *msg) {
@@ -213,21 +241,57 @@ void bind_objects(nb::module_ &m)
             "The sampler back end in use (never AUTO).")
         .def(
             "load_volume",
-            [](Context &c, const std::string &path) {
+            [](Context &c, const std::string &path,
+               std::optional<std::vector<std::string>> data_roots) {
+                const char *p = path_arg(path, "umbra.Context.load_volume: path");
+                std::vector<const char *> roots; /* into data_roots, alive for the call */
+                if (data_roots)
+                    for (const std::string &r : *data_roots)
+                        roots.push_back(path_arg(r, "umbra.Context.load_volume: data_roots entry"));
+                umbra_volume_load_options o;
+                umbra_volume_load_options_init(&o);
+                o.data_roots = roots.empty() ? nullptr : roots.data();
+                o.data_root_count = roots.size();
                 umbra_volume v = nullptr;
-                check(c.get(), umbra_volume_load(c.get(), path.c_str(), &v));
+                check(c.get(), umbra_volume_load_with_options(c.get(), p, &o, &v));
                 return Volume(c.h, v);
             },
-            "path"_a,
+            "path"_a, nb::kw_only(), "data_roots"_a = nb::none(),
             "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib), .mha/.mhd "
-            "(MetaImage) or .dat (Voreen) through umbra_io, with the file's spacing and world "
-            "transform (NRRD space directions, NIfTI sform/qform, MetaImage Offset and "
-            "TransformMatrix).")
+            "(MetaImage), .dat (Voreen), .tif/.tiff (TIFF stacks, OME-TIFF), .dcm (DICOM), or a "
+            "directory (a DICOM series, or a TIFF stack when it holds .tif files) through "
+            "umbra_io, with the file's spacing and world transform (NRRD space directions, "
+            "NIfTI sform/qform, MetaImage Offset and TransformMatrix, DICOM patient space). A "
+            "detached data file (NRRD 'data file', MetaImage ElementDataFile, Voreen "
+            "ObjectFileName) must lie in the header's own directory (after symbolic links and "
+            "'..'), else umbra.Error ERROR_IO naming it; data_roots, a list of directories, "
+            "allows those too ('/' allows any file).")
+        .def(
+            "load_volume",
+            [](Context &c, const std::vector<std::string> &paths) {
+                std::vector<const char *> p;
+                bool tiff = !paths.empty();
+                for (const std::string &s : paths) {
+                    p.push_back(path_arg(s, "umbra.Context.load_volume: paths entry"));
+                    size_t dot = s.rfind('.');
+                    std::string ext = dot == std::string::npos ? "" : s.substr(dot);
+                    tiff &= ext == ".tif" || ext == ".tiff" || ext == ".TIF" || ext == ".TIFF";
+                }
+                umbra_volume v = nullptr;
+                check(c.get(), tiff ? umbra_volume_load_tiff(c.get(), p.data(), p.size(), &v)
+                                    : umbra_volume_load_dicom(c.get(), p.data(), p.size(), &v));
+                return Volume(c.h, v);
+            },
+            "paths"_a,
+            "Loads a list of files as one volume: single-page TIFFs (all named .tif/.tiff) as "
+            "slices in the order given (umbra_volume_load_tiff), else the files of one DICOM "
+            "series in any order, sorted by position (umbra_volume_load_dicom).")
         .def(
             "load_transfer_function",
             [](Context &c, const std::string &path) {
                 umbra_transfer_function t = nullptr;
-                check(c.get(), umbra_transfer_function_load(c.get(), path.c_str(), &t));
+                const char *p = path_arg(path, "umbra.Context.load_transfer_function: path");
+                check(c.get(), umbra_transfer_function_load(c.get(), p, &t));
                 return TransferFunction(c.h, t);
             },
             "path"_a,
@@ -250,7 +314,8 @@ void bind_objects(nb::module_ &m)
                                   "pass numpy.ascontiguousarray(rgba)");
                 if (a.shape(0) > UINT32_MAX || a.shape(1) > UINT32_MAX)
                     raise_invalid("umbra.Context.write_image: image too large");
-                check(c.get(), umbra_image_write(c.get(), path.c_str(), (uint32_t)a.shape(1),
+                const char *p = path_arg(path, "umbra.Context.write_image: path");
+                check(c.get(), umbra_image_write(c.get(), p, (uint32_t)a.shape(1),
                                                  (uint32_t)a.shape(0), (const float *)a.data()));
             },
             "path"_a, "rgba"_a,
@@ -261,7 +326,9 @@ void bind_objects(nb::module_ &m)
             [](Context &c, const std::string &path) {
                 uint32_t w = 0, h = 0;
                 float *p = nullptr;
-                check(c.get(), umbra_image_read(c.get(), path.c_str(), &w, &h, &p));
+                check(c.get(), umbra_image_read(c.get(),
+                                                path_arg(path, "umbra.Context.read_image: path"),
+                                                &w, &h, &p));
                 nb::capsule owner(p, [](void *q) noexcept { std::free(q); });
                 return float_out(p, {h, w, 4}, owner);
             },
@@ -393,10 +460,7 @@ void bind_objects(nb::module_ &m)
         .def(
             "set_shadow",
             [](Renderer &r, const nb::kwargs &kw) {
-                umbra_shadow_desc d;
-                umbra_shadow_desc_init(&d);
-                apply_kwargs(d, kw, "umbra.Renderer.set_shadow");
-                renderer_set_shadow(r, d);
+                renderer_set_shadow_kwargs(r, kw, "umbra.Renderer.set_shadow");
             },
             nb::sig("def set_shadow(self, **params: typing.Any) -> None"), set_shadow_doc.c_str())
         .def(
@@ -417,12 +481,8 @@ void bind_objects(nb::module_ &m)
             "render",
             [](Renderer &r, uint32_t width, uint32_t height, nb::handle out, const nb::kwargs &kw) {
                 umbra_renderer h = r.get();
-                if (kw.size()) {
-                    umbra_shadow_desc d;
-                    umbra_shadow_desc_init(&d);
-                    apply_kwargs(d, kw, "umbra.Renderer.render");
-                    renderer_set_shadow(r, d);
-                }
+                if (kw.size())
+                    renderer_set_shadow_kwargs(r, kw, "umbra.Renderer.render");
                 nb::object result;
                 float *dst = nullptr;
                 if (out.is_none()) {
@@ -505,9 +565,10 @@ void bind_objects(nb::module_ &m)
             "device work, with the fraction done: in [0, 1], non-decreasing, exactly 1 in the "
             "last call of a call that succeeds. A true return value cancels: the call raises "
             "umbra.Error with status ERROR_CANCELLED and the renderer stays usable. An exception "
-            "raised by f cancels the same way and propagates. Ctrl-C cancels every render "
-            "(with or without f) at the next piece and raises KeyboardInterrupt. f must not use "
-            "this renderer. None: no callable.")
+            "raised by f, or by truth-testing its result, cancels the same way and propagates. "
+            "Ctrl-C cancels every render (with or without f) at the next piece and raises "
+            "KeyboardInterrupt. Neither f nor another thread may use this renderer while the "
+            "call runs (RuntimeError). None: no callable.")
         .def_prop_ro(
             "stats",
             [](const Renderer &r) {

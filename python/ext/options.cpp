@@ -2,7 +2,12 @@
 /* options.cpp: RenderOptions, ShadowOptions, Camera and Light, the C structs umbra_render_desc,
  * umbra_shadow_desc, umbra_camera and umbra_light bound field by field. Each field is named once,
  * with a pointer to the C member: its type and storage come from the C header, its default from
- * the C desc_init function (never repeated here). A new C field is one more line below. */
+ * the C desc_init function (never repeated here). A new C field is one more line below.
+ * ShadowOptions' parameters come from the technique registry (umbra/registry.h) instead: one
+ * property per key (map_size, taps, reference_step, ...), read and set through
+ * umbra_shadow_desc_get_param / _set_param, which check the range; a key several techniques
+ * have (taps) sets it in each of them and reads the current technique's. */
+#include <algorithm>
 #include <cctype>
 #include <cstring>
 
@@ -90,6 +95,70 @@ void enum_field(nb::class_<T> &cls, const char *name, E T::*m, const char *type,
                }});
 }
 
+/* "none, reference, ..." for the technique field's doc. */
+std::string technique_names()
+{
+    std::string s;
+    for (uint32_t i = 0; i < umbra_technique_count(); ++i)
+        s += std::string(i ? ", " : "") + umbra_technique_get(i)->name;
+    return "the shadow technique: " + s;
+}
+
+/* One property per registry key, in registry order, each set in every technique that has it. */
+void shadow_params(nb::class_<umbra_shadow_desc> &so)
+{
+    std::vector<std::string> seen;
+    for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
+        const umbra_technique_info *ti = umbra_technique_get(t);
+        for (uint32_t k = 0; k < ti->param_count; ++k) {
+            const umbra_param_info *p = umbra_technique_param_get(ti, k);
+            std::string key = p->key;
+            if (std::find(seen.begin(), seen.end(), key) != seen.end())
+                continue;
+            seen.push_back(key);
+            std::string owners;
+            for (uint32_t u = 0; u < umbra_technique_count(); ++u)
+                if (umbra_technique_param_find(umbra_technique_get(u), p->key))
+                    owners += std::string(owners.empty() ? "" : ", ") +
+                              umbra_technique_get(u)->name;
+            std::string doc =
+                owners + ": " + p->doc + (p->unit ? std::string(", in ") + p->unit : "");
+            const umbra_param_type type = p->type;
+            std::string py_type = type == UMBRA_PARAM_FLOAT  ? "float"
+                                  : type == UMBRA_PARAM_UINT ? "int"
+                                                             : "bool";
+            add_field(so, {key, py_type, doc,
+                           [key, type](const umbra_shadow_desc &d) {
+                               double v = 0.0;
+                               umbra_shadow_desc_get_param(&d, nullptr, key.c_str(), &v);
+                               if (type == UMBRA_PARAM_FLOAT)
+                                   return nb::object(py_float((float)v));
+                               if (type == UMBRA_PARAM_UINT)
+                                   return nb::object(nb::int_((uint32_t)v));
+                               return nb::object(nb::bool_(v != 0.0));
+                           },
+                           [key, type](umbra_shadow_desc &d, nb::handle v) {
+                               double x;
+                               if (type == UMBRA_PARAM_FLOAT) {
+                                   x = nb::cast<float>(v);
+                               } else if (type == UMBRA_PARAM_UINT) {
+                                   if (nb::isinstance<nb::bool_>(v))
+                                       throw nb::cast_error();
+                                   x = nb::cast<uint32_t>(v);
+                               } else {
+                                   if (!PyBool_Check(v.ptr()) && !PyLong_Check(v.ptr()))
+                                       throw nb::cast_error();
+                                   x = PyObject_IsTrue(v.ptr()) ? 1.0 : 0.0;
+                               }
+                               char msg[1024];
+                               if (umbra_shadow_desc_set_param(&d, nullptr, key.c_str(), x, msg,
+                                                               sizeof msg) != UMBRA_SUCCESS)
+                                   raise_invalid(msg);
+                           }});
+        }
+    }
+}
+
 template <class T> std::string repr_of(const T &d, const char *name)
 {
     std::string s = std::string("umbra.") + name + "(";
@@ -123,6 +192,34 @@ template <class T> void make_repr(nb::class_<T> &cls, const char *name)
 }
 
 } // namespace
+
+void apply_shadow_kwargs(umbra_shadow_desc &d, const nb::kwargs &kw, const char *what,
+                         int *preintegrated)
+{
+    nb::kwargs first, rest;
+    if (preintegrated)
+        *preintegrated = -1;
+    for (auto [k, v] : kw) {
+        std::string key = nb::cast<std::string>(k);
+        if (key == "preintegrated") {
+            if (!preintegrated)
+                throw nb::type_error((std::string(what) + ": preintegrated is a RenderOptions "
+                                                          "field since umbra 0.5")
+                                         .c_str());
+            if (!PyBool_Check(v.ptr()) && !PyLong_Check(v.ptr()))
+                throw nb::type_error((std::string(what) + ": preintegrated=" +
+                                      nb::cast<std::string>(nb::repr(v)) + " is not a valid bool")
+                                         .c_str());
+            *preintegrated = PyObject_IsTrue(v.ptr()) ? 1 : 0;
+        } else if (key == "technique") {
+            first[k] = v;
+        } else {
+            rest[k] = v;
+        }
+    }
+    apply_kwargs(d, first, what);
+    apply_kwargs(d, rest, what);
+}
 
 const std::string &render_fields_doc()
 {
@@ -163,52 +260,19 @@ void bind_options(nb::module_ &m)
           "gap between the box's lowest y and the plane, a fraction of the box diagonal");
     enum_field(ro, "transmission", &umbra_render_desc::transmission, "Transmission",
                "grey shadows, or coloured from the light transfer function's RGB");
+    flag(ro, "preintegrated", &umbra_render_desc::preintegrated,
+         "pre-integrated segments: the view ray's, and the convolution technique's light");
     make_repr(ro, "RenderOptions");
 
     nb::class_<umbra_shadow_desc> so(m, "ShadowOptions");
     so.def("__init__", [](umbra_shadow_desc *d, const nb::kwargs &kw) {
         new (d) umbra_shadow_desc;
         umbra_shadow_desc_init(d);
-        apply_kwargs(*d, kw, "umbra.ShadowOptions");
+        apply_shadow_kwargs(*d, kw, "umbra.ShadowOptions");
     });
     enum_field(so, "technique", &umbra_shadow_desc::technique, "Technique",
-               "none, reference, threshold, deep, cssm or convolution");
-    field(so, "reference_step", &umbra_shadow_desc::reference_step,
-          "reference: shadow-ray step in voxels");
-    field(so, "map_size", &umbra_shadow_desc::map_size,
-          "light-space maps: map_size^2 texels, 0 (MAP_SIZE_AUTO, the default: "
-          "map_texels_per_voxel texels per voxel seen from the light; stats.map_size says what "
-          "was chosen) or 16..8192");
-    field(so, "map_texels_per_voxel", &umbra_shadow_desc::map_texels_per_voxel,
-          "light-space maps at MAP_SIZE_AUTO: texels per voxel, 0 (the technique's own: "
-          "threshold 1, cssm 3, deep 2) or 0.25..8; 1 is a draft while the light moves");
-    field(so, "map_step", &umbra_shadow_desc::map_step,
-          "light-space maps: light-ray step in voxels, 0 (the technique's own, the default: "
-          "threshold 1, cssm 1, deep 0.5) or 0.01..64");
-    field(so, "threshold", &umbra_shadow_desc::threshold,
-          "threshold map: accumulated light opacity in (0, 1) at which the depth is stored");
-    field(so, "taps", &umbra_shadow_desc::taps,
-          "CSSM / filtered threshold: texels averaged per lookup, 1, 7, 13 or 21");
-    field(so, "epsilon", &umbra_shadow_desc::epsilon,
-          "deep map: compression error bound in [0, 1]");
-    field(so, "max_nodes", &umbra_shadow_desc::max_nodes,
-          "deep map: nodes per texel, 0 (unbounded) or 2..64");
-    field(so, "block_size", &umbra_shadow_desc::block_size,
-          "deep map: node layers per block, 1..256");
-    field(so, "prefilter", &umbra_shadow_desc::prefilter,
-          "deep map: sub-pixel rays per texel, 1 or 5");
-    flag(so, "lookup_table", &umbra_shadow_desc::lookup_table,
-         "deep map: use the pre-compressed segment table");
-    field(so, "seed", &umbra_shadow_desc::seed, "CSSM: seed of the random numbers");
-    field(so, "ray_block", &umbra_shadow_desc::ray_block,
-          "CSSM: texels per side whose photons share a light ray, 0 (the map's own) or 1..3");
-    field(so, "slice_distance", &umbra_shadow_desc::slice_distance,
-          "convolution: voxels between slices, [0.02, 16]");
-    field(so, "subsamples", &umbra_shadow_desc::subsamples,
-          "convolution (SCS): volume samples between two slices, 0..64");
-    flag(so, "preintegrated", &umbra_shadow_desc::preintegrated, "pre-integrated segments");
-    field(so, "cone_angle_degrees", &umbra_shadow_desc::cone_angle_degrees,
-          "convolution: half-angle of the blur cone per slice, [0, 60]");
+               technique_names().c_str());
+    shadow_params(so);
     make_repr(so, "ShadowOptions");
 
     nb::class_<umbra_camera> cam(m, "Camera");

@@ -59,6 +59,19 @@ void check(umbra_context ctx, umbra_status st)
     throw nb::value_error((std::string("umbra.") + what + " is closed").c_str());
 }
 
+const char *path_arg(const std::string &path, const char *what)
+{
+    size_t at = path.find('\0');
+    if (at != std::string::npos) {
+        std::string shown = nb::cast<std::string>(nb::repr(nb::str(path.data(), path.size())));
+        throw nb::value_error((std::string(what) + " " + shown + " contains a NUL character (at " +
+                               std::to_string(at) + "); a file name cannot, and it is refused "
+                               "rather than cut there")
+                                  .c_str());
+    }
+    return path.c_str();
+}
+
 /* ---- arrays ----------------------------------------------------------------------------------- */
 
 std::string dtype_name(nb::dlpack::dtype t)
@@ -107,6 +120,10 @@ any_array as_array(nb::handle obj, const char *what)
 
 void need_c_contiguous(const any_array &a, const char *what, const char *hint)
 {
+    /* An empty array has no layout to get wrong, and its strides are whatever the exporter says
+     * (NumPy 2 gives (0, 0) for shape (0, 3)): its size is checked by the caller. */
+    if (a.size() == 0)
+        return;
     int64_t expect = 1;
     for (size_t i = a.ndim(); i-- > 0;) {
         if (a.shape(i) != 1 && a.stride(i) != expect) {

@@ -14,12 +14,12 @@ def raises_invalid(match):
     return pytest.raises(umbra.Error, match=match)
 
 
-@pytest.mark.parametrize("dtype", [np.float64, np.int32, np.int8, np.uint32, np.bool_])
+@pytest.mark.parametrize("dtype", [np.complex64, np.complex128])
 def test_volume_wrong_dtype(ctx, dtype):
-    with raises_invalid(np.dtype(dtype).name) as e:
+    with raises_invalid(np.dtype(dtype).name + " is not supported") as e:
         umbra.Volume(ctx, np.zeros((4, 4, 4), dtype))
     assert e.value.status == INVALID
-    assert "uint8, uint16, int16 or float32" in e.value.message
+    assert "a real, integer or bool array" in e.value.message
 
 
 def test_volume_not_contiguous(ctx):

@@ -44,7 +44,8 @@ def write_ct(path):
 
 
 def volume_from_nifti(ctx, path):
-    """The README's recipe: nibabel's (x, y, z) array and affine to umbra.Volume."""
+    """The README's mapping by hand (Volume.from_nibabel does it too, test_adapters.py): nibabel's
+    (x, y, z) array and affine to umbra.Volume."""
     nib = pytest.importorskip("nibabel")
     img = nib.load(path)
     A = img.affine
@@ -56,7 +57,7 @@ def volume_from_nifti(ctx, path):
                         directions=(A[:3, :3] / spacing).T)
 
 
-def test_nifti_and_paraview_preset_match_the_cli(ctx, cli, tmp_path):
+def test_nifti_and_paraview_preset_match_the_cli(ctx, cli, read_exr, tmp_path):
     nii = tmp_path / "x.nii.gz"
     write_ct(nii)
     exr = tmp_path / "x.exr"
@@ -65,7 +66,7 @@ def test_nifti_and_paraview_preset_match_the_cli(ctx, cli, tmp_path):
     subprocess.run([str(cli), "--volume", str(nii), "--tf", str(CT_BONE), "--technique", "cssm",
                     "--size", f"{W}x{H}", "--out", str(exr)],
                    check=True, env=env, capture_output=True)
-    c_pixels = ctx.read_image(str(exr))
+    c_pixels = read_exr(exr)
 
     with volume_from_nifti(ctx, nii) as vol, ctx.load_transfer_function(str(CT_BONE)) as tf:
         assert tf.range == (-1024.0, 3071.0)             # the preset's x range, in HU
@@ -182,7 +183,8 @@ def write_mha(path, zyx, spacing, offset, matrix, compressed):
 
 @pytest.mark.parametrize("dtype,compressed", [(np.int16, True), (np.uint8, False),
                                               (np.float32, True)])
-def test_metaimage_loads_as_the_array_and_matches_the_cli(ctx, cli, tmp_path, dtype, compressed):
+def test_metaimage_loads_as_the_array_and_matches_the_cli(ctx, cli, read_exr, tmp_path, dtype,
+                                                          compressed):
     """An .mha written here loads with the header's spacing, offset and axis directions and the
     array's values, and umbra-render --volume x.mha --tf preset draws what Python draws from the
     loaded volume."""
@@ -203,7 +205,7 @@ def test_metaimage_loads_as_the_array_and_matches_the_cli(ctx, cli, tmp_path, dt
     subprocess.run([str(cli), "--volume", str(mha), "--tf", str(preset), "--technique", "cssm",
                     "--size", f"{W}x{H}", "--out", str(exr)], check=True, env=env,
                    capture_output=True)
-    c_pixels = ctx.read_image(str(exr))
+    c_pixels = read_exr(exr)
     with ctx.load_volume(str(mha)) as theirs, \
             umbra.Volume(ctx, zyx, spacing=spacing, origin=offset, directions=matrix) as mine:
         a, b = mine.info, theirs.info

@@ -1,12 +1,15 @@
 # SPDX-License-Identifier: Apache-2.0
 """Progress and cancellation from Python: the fractions a render reports, a callable that cancels
 (umbra.Error with status ERROR_CANCELLED, the renderer usable afterwards), an exception in the
-callable and Ctrl-C (SIGINT) cancelling a render and propagating, and bad callables refused."""
+callable (or in truth-testing what it returned) and Ctrl-C (SIGINT) cancelling a render and
+propagating, bad callables refused, and another thread that reaches a renderer while its callable
+runs told so."""
 
 import ctypes
 import functools
 import os
 import signal
+import threading
 
 import numpy as np
 import pytest
@@ -90,6 +93,55 @@ def test_exception_in_the_callable_cancels_and_propagates(renderer):
         renderer.render(W, H)
     renderer.progress = None
     assert np.isfinite(renderer.render(W, H)).all()
+
+
+def test_a_result_that_fails_truth_testing_propagates(renderer):
+    # the callable returns; judging its result raises (numpy arrays of several elements do too)
+    class Undecided:
+        def __bool__(self):
+            raise ValueError("no truth value here")
+
+    renderer.progress = lambda f: Undecided()
+    with pytest.raises(ValueError, match="no truth value here"):
+        renderer.render(W, H)
+    renderer.progress = lambda f: np.array([True, False])
+    with pytest.raises(ValueError, match="truth value of an array"):
+        renderer.render(W, H)
+    renderer.progress = None
+    assert np.isfinite(renderer.render(W, H)).all()
+
+
+def test_another_thread_is_told_the_renderer_is_busy(renderer):
+    # while the callable waits (releasing the GIL), a second thread calls the same renderer: it
+    # is refused as a second thread, not as the callable, and the first render completes
+    started, tried = threading.Event(), threading.Event()
+    errors = []
+
+    def hold(f):
+        if not started.is_set():
+            started.set()
+            assert tried.wait(60)
+
+    def other():
+        assert started.wait(60)
+        try:
+            renderer.render(8, 8)
+        except RuntimeError as e:
+            errors.append(str(e))
+        finally:
+            tried.set()
+
+    renderer.progress = hold
+    renderer.light = umbra.Light.directional((0.4, -1, 0.3))
+    t = threading.Thread(target=other)
+    t.start()
+    image = renderer.render(W, H)
+    t.join(60)
+    assert len(errors) == 1, errors
+    assert "another thread renders with it" in errors[0], errors
+    assert "own progress callback" not in errors[0]
+    renderer.progress = None
+    assert np.array_equal(image, renderer.render(W, H))
 
 
 def test_exception_from_ctrl_c_in_the_callable(renderer):

@@ -27,14 +27,14 @@ def convolution_light(camera):
 
 
 @pytest.mark.parametrize("technique", ["none", "reference", "cssm", "deep"])
-def test_matches_the_cli_pixels(ctx, spheres, cli, tmp_path, technique):
+def test_matches_the_cli_pixels(ctx, spheres, cli, read_exr, tmp_path, technique):
     exr = tmp_path / f"{technique}.exr"
     env = dict(os.environ)
     env.setdefault("POCL_CACHE_DIR", str(tmp_path / "pocl-cache"))
     subprocess.run([str(cli), "--scene", "spheres", "--technique", technique, "--map-size", "256",
                     "--size", f"{W}x{H}", "--out", str(exr)],
                    check=True, env=env, capture_output=True)
-    c_pixels = ctx.read_image(str(exr))
+    c_pixels = read_exr(exr)
     with spheres.renderer() as r:
         # the scene's renderer carries the scene's options, as umbra-render's --scene does
         assert r.options == spheres.options and r.options.ground_plane
@@ -187,7 +187,41 @@ def test_transfer_function_table_and_points(ctx):
     assert len(tf3) == 256
 
 
+needs_image_io = pytest.mark.skipif(not umbra.has_image_io,
+                                    reason="this umbra is built without OpenImageIO (the wheel)")
+
+
+@needs_image_io
 def test_image_round_trip(ctx, tmp_path):
     img = np.random.default_rng(2).random((5, 7, 4), dtype=np.float32)
     ctx.write_image(str(tmp_path / "a.exr"), img)
     assert np.array_equal(ctx.read_image(str(tmp_path / "a.exr")), img)
+
+
+@pytest.mark.skipif(umbra.has_image_io, reason="this umbra has image I/O")
+def test_without_image_io_images_are_refused_by_name(ctx, tmp_path):
+    img = np.zeros((2, 3, 4), np.float32)
+    for call in (lambda p: ctx.write_image(p, img), ctx.read_image):
+        with pytest.raises(umbra.Error, match="a.png.*built without OpenImageIO") as e:
+            call(str(tmp_path / "a.png"))
+        assert e.value.status == umbra.Status.ERROR_UNSUPPORTED
+    assert not (tmp_path / "a.png").exists()
+
+
+@needs_image_io
+def test_to_srgb8_gives_the_c_png_writers_pixels(ctx, spheres, tmp_path):
+    Image = pytest.importorskip("PIL.Image")
+    with spheres.renderer() as r:
+        img = r.render(W, H, technique="cssm")
+    # premultiplied colours, alphas from 0 to 1 and out of range, as a render can give them
+    rng = np.random.default_rng(5)
+    extra = rng.random((H, W, 4), dtype=np.float32) * np.float32(1.2) - np.float32(0.1)
+    extra[..., :3] *= np.clip(extra[..., 3:], 0, 1)
+    for rgba in (img, extra):
+        ctx.write_image(str(tmp_path / "c.png"), rgba)
+        theirs = np.asarray(Image.open(tmp_path / "c.png").convert("RGBA"))
+        mine = umbra.to_srgb8(rgba)
+        assert mine.shape == theirs.shape == (H, W, 4) and mine.dtype == np.uint8
+        # the same float32 arithmetic as io/image.cpp; powf may round one value differently
+        assert np.abs(mine.astype(int) - theirs).max() <= 1
+        assert np.mean(mine == theirs) > 0.999

@@ -11,12 +11,27 @@ shape (z, y, x) and copied once, to the device; ``Renderer.render`` returns a ne
         scene = umbra.Scene(ctx, "spheres")
         with scene.renderer() as r:
             img = r.render(256, 256, technique="cssm", taps=7)
+        umbra.Image(img)   # in a notebook, a cell ending in this shows the picture
+
+Arrays of any real, integer or bool dtype are accepted (uint8, uint16, int16 and float32 as they
+are, others converted once: see :class:`Volume`); ``Volume.from_nibabel``, ``from_sitk`` and
+``from_vtk`` take those libraries' images with their placement. Installed from the wheel
+(``pip install umbra-dvr``) umbra uses the system's OpenCL drivers, else PoCL from PyPI
+(``pip install 'umbra-dvr[pocl]'``); the wheel has no PNG/EXR I/O (``has_image_io``):
+:func:`to_srgb8` gives 8-bit pixels for Pillow or imageio.
 
 Every failure raises :class:`umbra.Error`, whose ``status`` is an :class:`umbra.Status` and whose
 ``message`` is umbra's, naming the function and the value. Context, Volume, TransferFunction and
 Renderer close deterministically (``with`` or ``close()``) and may be garbage-collected in any
 order: each holds a reference on the C objects it needs.
 """
+
+from . import _opencl
+
+# Before the OpenCL loader's first call: the system's drivers, else PoCL from PyPI.
+driver_from_pypi = _opencl.choose_drivers()
+"""The PoCL library from PyPI (the ``pocl`` extra) the OpenCL loader was pointed at because the
+system has no driver, or None (the system's drivers, or OCL_ICD_VENDORS as the user set it)."""
 
 try:
     from ._umbra import (
@@ -39,6 +54,7 @@ try:
         Transmission,
         Volume,
         VolumeInfo,
+        has_image_io,
         scene_names,
         technique_names,
         version,
@@ -52,12 +68,18 @@ except ImportError as e:  # pragma: no cover - depends on how Python was started
         "outside python/."
     ) from e
 
+from ._display import Image, install_reprs, show, to_srgb8
+
+install_reprs(VolumeInfo, RenderStats)
+del install_reprs
+
 __version__: str = version()
 
 __all__ = [
     "Camera",
     "Context",
     "Error",
+    "Image",
     "Light",
     "LightType",
     "MAP_SIZE_AUTO",
@@ -74,7 +96,11 @@ __all__ = [
     "Transmission",
     "Volume",
     "VolumeInfo",
+    "driver_from_pypi",
+    "has_image_io",
     "scene_names",
+    "show",
     "technique_names",
+    "to_srgb8",
     "version",
 ]

@@ -81,6 +81,23 @@ expect 1 "not a regular file" -- --raw "$tmp/fifo" --raw-dims 2x2x2 --raw-type u
     --size 16x16 --out "$tmp/a.png"
 ln -s "$tmp/fifo" "$tmp/fifo.nrrd"
 expect 1 "not a regular file" -- --volume "$tmp/fifo.nrrd" --size 16x16 --out "$tmp/a.png"
+# #29 item 1: a header's data file outside its directory is refused (exit 1, naming the file)
+# unless --allow-data-root names where it lies (tests/test_data_files.c checks the voxels).
+mkdir "$tmp/hdr" "$tmp/elsewhere"
+head -c 4096 /dev/urandom >"$tmp/elsewhere/secret.raw"
+printf 'NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nElementDataFile = %s\n' \
+    "$tmp/elsewhere/secret.raw" >"$tmp/hdr/abs.mhd"
+printf 'NRRD0004\ntype: uchar\ndimension: 3\nsizes: 16 16 16\nencoding: raw\n%s\n' \
+    'data file: ../elsewhere/secret.raw' >"$tmp/hdr/up.nhdr"
+for h in abs.mhd up.nhdr; do
+    expect 1 "outside \"$tmp/hdr\" (the header's directory)" -- \
+        --volume "$tmp/hdr/$h" --size 16x16 --out "$tmp/a.png"
+    expect 0 "wrote" -- --volume "$tmp/hdr/$h" --allow-data-root "$tmp/elsewhere" --size 16x16 \
+        --out "$tmp/a.png"
+done
+expect 1 "outside every data root given" -- --volume "$tmp/hdr/up.nhdr" \
+    --allow-data-root "$tmp/hdr" --size 16x16 --out "$tmp/a.png"
+expect 1 "--allow-data-root needs a value" -- --allow-data-root
 
 if [[ $failures -ne 0 ]]; then
     echo "$failures case(s) failed"

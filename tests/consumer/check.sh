@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tests/consumer/check.sh SOURCE_DIR BUILD_DIR: umbra as an application takes it in.
-#  1. `cmake --install` into a fresh prefix; nothing installed names the source or build tree.
+#  1. `cmake --install` into a fresh prefix; no installed file, binaries included, names the source
+#     or build tree; the installed umbra-render finds an installed preset by name.
 #  2. The consumers (a copy of this folder, outside the source tree) build and run against the
 #     prefix alone through find_package(umbra), then through pkg-config (umbra, umbra-io, and the
 #     static libraries with --static), then with umbra as an add_subdirectory of theirs.
@@ -29,14 +30,29 @@ for f in libumbra.so libumbra.a libumbra_io.so libumbra_io.a cmake/umbra/umbraCo
 done
 soname=$(objdump -p "$libdir/libumbra.so" | awk '/SONAME/ {print $2}')
 case "$soname" in libumbra.so.[0-9]*) ;; *) fail "libumbra.so has no versioned soname ($soname)";; esac
-for f in umbra.h io.h config.h context.h; do
+for f in umbra.h io.h config.h context.h registry.h techniques/list.h techniques/cssm.h; do
   [ -f "$prefix/include/umbra/$f" ] || fail "header not installed: include/umbra/$f"
 done
 [ -x "$prefix/bin/umbra-render" ] || fail "umbra-render not installed"
 "$prefix/bin/umbra-render" --version | grep -q "umbra-render" || fail "umbra-render --version"
-if grep -rIl -e "$src" -e "$build" "$prefix/include" "$libdir/cmake" "$libdir/pkgconfig"; then
-  fail "the files above name the source or build tree"
+for f in paraview.json LICENSE; do
+  [ -f "$prefix/share/umbra/presets/$f" ] || fail "not installed: share/umbra/presets/$f"
+done
+# The installed tool finds an installed preset by name, from a directory that holds none.
+(cd "$work" && env -u UMBRA_PRESET_PATH "$prefix/bin/umbra-render" --tf "Cool to Warm" \
+   --technique none --size 16x16 --out "$work/preset.png" 2>/dev/null) ||
+  fail "the installed umbra-render does not find the preset \"Cool to Warm\" by name"
+# Every installed file, binaries included (-a): a path left by __FILE__ or the debug information
+# names the machine that built it (CMakeLists.txt maps both trees away with -ffile-prefix-map).
+named=$(grep -rlaF -e "$src" -e "$build" "$prefix" || true)
+if [ -n "$named" ]; then
+  for f in $named; do
+    echo "$f: $(grep -aoF -e "$src" -e "$build" "$f" | wc -l) occurrences, e.g." \
+         "$(strings -a "$f" | grep -F -e "$src" -e "$build" | head -n1)" >&2
+  done
+  fail "the installed files above name the source or build tree"
 fi
+echo "no installed file ($(find "$prefix" -type f | wc -l) of them) names $src or $build"
 cp -r "$src/tests/consumer" "$work/consumer"
 
 echo "== find_package(umbra) from the prefix"
@@ -49,8 +65,13 @@ cmake --build "$work/fp" -j"$jobs" >/dev/null
 
 echo "== pkg-config"
 export PKG_CONFIG_PATH=$libdir/pkgconfig
+# Without CL_TARGET_OPENCL_VERSION, as most applications include it: nothing printed, no note
+# from CL/cl_version.h either.
 cc -std=c11 -Wall -Wextra -Werror -o "$work/pc_c" "$work/consumer/consumer.c" \
-   $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir"
+   $(pkg-config --cflags --libs umbra) -Wl,-rpath,"$libdir" 2>"$work/pc_c.log" ||
+  { cat "$work/pc_c.log" >&2; fail "consumer.c does not build through pkg-config"; }
+[ ! -s "$work/pc_c.log" ] ||
+  { cat "$work/pc_c.log" >&2; fail "including umbra.h printed the above"; }
 "$work/pc_c"
 c++ -std=c++17 -Wall -Wextra -Werror -DCL_TARGET_OPENCL_VERSION=300 -o "$work/pc_cxx" \
     "$work/consumer/consumer.cpp" $(pkg-config --cflags --libs umbra-io) -Wl,-rpath,"$libdir"

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* consumer.c: the smallest application on libumbra alone (no umbra_io). It renders the built-in
- * scene with the exact reference shadows and checks the picture is not empty.
+ * scene with the exact reference shadows and checks the picture is not empty; before that it
+ * reads the technique registry (every technique has a name, the reference a step parameter it
+ * sets by name).
  * Usage: consumer_c            render; exit 0 on success
  *        consumer_c --idle     load the library, do no OpenCL work, print peak RSS (kB) */
 #include <stdio.h>
@@ -41,6 +43,16 @@ int main(int argc, char **argv)
     umbra_shadow_desc shadow;
     umbra_shadow_desc_init(&shadow);
     shadow.technique = UMBRA_SHADOW_REFERENCE;
+    for (uint32_t i = 0; i < umbra_technique_count(); ++i)
+        if (!umbra_technique_get(i)->name[0])
+            return 1;
+    char msg[256];
+    if (umbra_shadow_desc_set_param(&shadow, "reference", "reference_step", 0.5, msg,
+                                    sizeof msg) != UMBRA_SUCCESS ||
+        shadow.reference.step != 0.5f) {
+        fprintf(stderr, "consumer_c: %s\n", msg);
+        return 1;
+    }
 
     umbra_status st = umbra_context_create(NULL, &ctx);
     if (!st) st = umbra_scene_create(ctx, "spheres", 48, &scene);

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-/* tests/fuzz/fuzz_volume.c: libFuzzer harness for the volume readers through the public API.
- * The first byte picks the reader: 0 an attached NRRD (.nrrd), 1 a detached NRRD (.nhdr) whose
- * data file "data.raw" holds what follows the first "@@" in the input, 2 a Voreen .dat over
- * "data.raw" the same way, 3 a headerless raw file with dims, type and header bytes taken from the
- * next four bytes, 4 a MetaImage .mha, 5 a MetaImage .mhd over "data.raw" as for 1 and 2 (its
- * ElementDataFile must say data.raw to reach it). Everything must end in a volume or a status with a message, never a crash,
- * leak or sanitizer report, and the context must stay usable (the next input uses it).
+/* tests/fuzz/fuzz_volume.c: libFuzzer harness for the volume readers through the public API. The
+ * first byte picks the reader: 0 an attached NRRD (.nrrd), 1 a detached NRRD (.nhdr) whose data
+ * file "data.raw" holds what follows the first "@@" in the input, 2 a Voreen .dat over "data.raw"
+ * the same way, 3 a headerless raw file with dims, type and header bytes taken from the next four
+ * bytes, 4 a MetaImage .mha, 5 a MetaImage .mhd over "data.raw" as for 1 and 2 (its ElementDataFile
+ * must say data.raw to reach it), 6 a NIfTI-1/2 .nii, 7 the same bytes gzip-compressed as a
+ * .nii.gz, 8 a DICOM file (.dcm: umbra's structure walk, then GDCM's decoders), 9 a TIFF (.tif:
+ * libtiff, OME-XML through expat). Everything must end in a volume or a status with a message,
+ * never a crash, leak or sanitizer report, and the context must stay usable (the next input uses
+ * it).
  *
  * Speed: the loaders refuse any size the file cannot hold, so with libFuzzer's -max_len 4096 raw
  * volumes stay small; only ZRL can legitimately expand 4 kB into 64 MB of voxels, so inputs that
@@ -14,6 +17,8 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <ctype.h>
+
+#include <zlib.h>
 
 #include "fuzz_util.h"
 
@@ -38,14 +43,15 @@ static double declared_voxels(const char *text)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char *const names[6] = {"input.nrrd", "input.nhdr", "input.dat", NULL,
-                                         "input.mha",  "input.mhd"};
+    static const char *const names[10] = {"input.nrrd", "input.nhdr", "input.dat", NULL,
+                                          "input.mha",  "input.mhd",  "input.nii", "input.nii.gz",
+                                          "input.dcm",  "input.tif"};
     if (size < 1)
         return 0;
     umbra_context ctx = fuzz_context();
     umbra_volume vol = NULL;
     umbra_status st;
-    int mode = data[0] % 6;
+    int mode = data[0] % 10;
     ++data;
     --size;
     if (mode != 3) {
@@ -61,13 +67,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (skip)
             return 0;
         const uint8_t *split = NULL;
-        for (size_t i = 0; mode > 0 && mode != 4 && i + 1 < size; ++i)
+        for (size_t i = 0; mode > 0 && mode != 4 && mode < 6 && i + 1 < size; ++i)
             if (data[i] == '@' && data[i + 1] == '@') {
                 split = data + i;
                 break;
             }
         size_t head = split ? (size_t)(split - data) : size;
-        fuzz_write(fuzz_path(names[mode]), data, head);
+        if (mode == 7) {
+            gzFile gz = gzopen(fuzz_path(names[mode]), "wb");
+            if (!gz || (size > 0 && gzwrite(gz, data, (unsigned)size) != (int)size))
+                abort();
+            gzclose(gz);
+        } else {
+            fuzz_write(fuzz_path(names[mode]), data, head);
+        }
         if (split)
             fuzz_write(fuzz_path("data.raw"), split + 2, size - head - 2);
         else
