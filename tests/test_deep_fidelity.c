@@ -287,10 +287,10 @@ static void test_deep_box_faces_along_an_axis_light(void **state)
 
 int main(void)
 {
-    (void)test_deep_box_faces_along_an_axis_light;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_deep_three_nodes_light_inside_head_phantom),
         cmocka_unit_test(test_deep_budgets_spheres_light_inside),
+        cmocka_unit_test(test_deep_box_faces_along_an_axis_light),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
