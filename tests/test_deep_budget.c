@@ -51,17 +51,6 @@ static float shell_value(double r)
     return (float)(0.8 * (in - out));
 }
 
-/* Deterministic per-voxel noise in [-1, 1] (a CT's grain: it makes the greedy fit emit many
- * nodes inside tissue and skin, which is what a node budget has to merge). */
-static double voxel_noise(int i, int j, int k)
-{
-    uint32_t h = (uint32_t)i * 73856093u ^ (uint32_t)j * 19349663u ^ (uint32_t)k * 83492791u;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return (double)(h & 0xffffu) / 32767.5 - 1.0;
-}
-
 static umbra_volume radial_volume(umbra_context ctx, float (*f)(double), double noise)
 {
     float *data = malloc((size_t)N_VOX * N_VOX * N_VOX * sizeof *data);
@@ -73,7 +62,7 @@ static umbra_volume radial_volume(umbra_context ctx, float (*f)(double), double 
             {
                 double v = f(sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)));
                 if (v > 0.0)
-                    v = fmin(fmax(v + noise * voxel_noise(i, j, k), 0.0), 1.0);
+                    v = fmin(fmax(v + noise * test_voxel_noise(i, j, k), 0.0), 1.0);
                 data[((size_t)k * N_VOX + j) * N_VOX + i] = (float)v;
             }
     umbra_volume v = test_volume_bricks(ctx, N_VOX, N_VOX, N_VOX, data, 8);

@@ -24,15 +24,6 @@
 
 enum { HEAD_N = 64, HEAD_W = 128 };
 
-static double head_noise(int i, int j, int k)
-{
-    uint32_t h = (uint32_t)i * 73856093u ^ (uint32_t)j * 19349663u ^ (uint32_t)k * 83492791u;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return (double)(h & 0xffffu) / 32767.5 - 1.0;
-}
-
 static double unit_clamp(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
 /* An ellipsoidal head, level r = 1 at the skin (radii 28, 24, 30 voxels, about 27 voxels per unit
@@ -54,7 +45,7 @@ static float head_value(int i, int j, int k, double table)
     const double dip = unit_clamp((r - in - th) * R + 0.5) - unit_clamp((r - out + th) * R + 0.5);
     double v = 0.3 * skin + 0.6 * fmax(t_in, t_out) + 0.25 * dip;
     if (v > 0.0)
-        v += 0.03 * head_noise(i, j, k);
+        v += 0.03 * test_voxel_noise(i, j, k);
     return (float)unit_clamp(v);
 }
 

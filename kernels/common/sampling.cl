@@ -167,19 +167,10 @@ UMBRA_INLINE float voxel_blended(VolGeom g, float b)
 #endif
 }
 
-inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+#if UMBRA_VOLUME_SLABS > 1
+/* The buffer of slab s. */
+UMBRA_INLINE __global const UMBRA_VOXEL_T *volume_slab(VOLUME_PARAM, int s)
 {
-    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
-    /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
-     * negative and huge values), a conversion one. */
-    int3 i0 = convert_int3(x);
-    float3 f = x - convert_float3(i0);
-    int3 i1 = min(i0 + 1, g.dims - 1);
-#if UMBRA_VOLUME_SLABS == 1
-    __global const UMBRA_VOXEL_T *restrict v = vol;
-#else
-    /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
-    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
     __global const UMBRA_VOXEL_T *v = vol_0;
     v = s == 1 ? vol_1 : v;
 #if UMBRA_VOLUME_SLABS > 2
@@ -200,6 +191,24 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 #if UMBRA_VOLUME_SLABS > 7
     v = s == 7 ? vol_7 : v;
 #endif
+    return v;
+}
+#endif
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
+     * negative and huge values), a conversion one. */
+    int3 i0 = convert_int3(x);
+    float3 f = x - convert_float3(i0);
+    int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_VOLUME_SLABS == 1
+    __global const UMBRA_VOXEL_T *restrict v = vol;
+#else
+    /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
+    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    __global const UMBRA_VOXEL_T *v = volume_slab(vol, s);
     i0.z -= s * UMBRA_SLAB_STEP;
     i1.z -= s * UMBRA_SLAB_STEP;
 #endif
@@ -236,26 +245,7 @@ UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
     __global const UMBRA_VOXEL_T *restrict v = vol;
 #else
     const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
-    __global const UMBRA_VOXEL_T *v = vol_0;
-    v = s == 1 ? vol_1 : v;
-#if UMBRA_VOLUME_SLABS > 2
-    v = s == 2 ? vol_2 : v;
-#endif
-#if UMBRA_VOLUME_SLABS > 3
-    v = s == 3 ? vol_3 : v;
-#endif
-#if UMBRA_VOLUME_SLABS > 4
-    v = s == 4 ? vol_4 : v;
-#endif
-#if UMBRA_VOLUME_SLABS > 5
-    v = s == 5 ? vol_5 : v;
-#endif
-#if UMBRA_VOLUME_SLABS > 6
-    v = s == 6 ? vol_6 : v;
-#endif
-#if UMBRA_VOLUME_SLABS > 7
-    v = s == 7 ? vol_7 : v;
-#endif
+    __global const UMBRA_VOXEL_T *v = volume_slab(vol, s);
     i0.z -= s * UMBRA_SLAB_STEP;
     i1.z -= s * UMBRA_SLAB_STEP;
 #endif
