@@ -167,7 +167,57 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         float3 p_pend = (float3)(0.0f), l_pend = (float3)(0.0f);
         float4 c_pend = (float4)(0.0f);
         float w_pend = 0.0f;
-        for (int k = k0;;) {
+        int k = k0;
+        /* Jitter moves where the ray's segments are cut, not where they begin. Sample k stands
+         * for the segment of one step that ends (1 - a) h / 2 past it (shadow_point), so the
+         * unjittered ray's segments tile the ray from half a step and more before t0, the first
+         * one's light taken in front of the box's face. Jittered samples at t0 + (k + jitter) h
+         * drop that first whole segment and the fraction jitter of a step before the next: a
+         * jittered first sample took its light up to a step deeper, in the shadow of the face
+         * of dense material itself (a lit face speckled dark and grey, neghip at alpha 0.99999:
+         * RMSE 0.10 against the unjittered image). So a jittered ray takes the unjittered first
+         * sample, at t0, as is, then the fraction as the unjittered second sample, at t0 + h,
+         * cut to it (its opacity for jitter h, its light at the fraction's mean emission depth
+         * from where that sample's segment begins), then the jittered samples from k = 1: the
+         * segments tile the ray from the same start as without jitter, the light of a dense
+         * face is where it was, and at jitter 0 and 1 the samples are the unjittered ones. Both
+         * are taken with their light at once, before the loop below. Only where nothing is clipped
+         * in front of the box's face: a clipped ray starts at its first jittered sample past the
+         * clip (k0). */
+        if (jitter > 0.0f && !(tc.x > t0)) {
+            for (int pre = 0; pre < 2 && alpha <= termination; ++pre) {
+                const float tp = t0 + (float)pre * h;
+                if (!(tp < t1))
+                    break;
+                const float3 p = o + tp * d;
+                const float frac = pre ? jitter : 1.0f;
+                float4 c;
+                ++taken;
+                if (preint_size) {
+                    c = preint_lookup(preint, preint_size, sample_volume(vol, g, p),
+                                      sample_volume(vol, g, p + (frac * h) * d));
+                    c.xyz = preint_color(c);
+                } else {
+                    c = view_sample(F, vol, g, view_tf, tf_size, p);
+                }
+                const float a = pre ? alpha_for_length(c.w, jitter) : c.w;
+                if (!(a > 0.0f))
+                    continue;
+                const float front = preint_size ? 0.0f : -0.5f * h * (1.0f + c.w);
+                const float3 l_at = pre ? p + (front + jitter * h * emission_depth(a)) * d
+                                    : preint_size ? p + (h * emission_depth(c.w)) * d
+                                                  : shadow_point(p, d, h, c.w);
+                const float3 s = SHADOW_FACTOR(sr, l_at);
+                const float3 grad = (flags & UMBRA_FLAG_SHADING)
+                                        ? view_gradient(F, vol, g, view_tf, p)
+                                        : (float3)(0.0f);
+                color += ((1.0f - alpha) * a) *
+                         shade_sample(F, c.xyz, s, p, -d, grad, l_ray, hv_ray);
+                alpha += (1.0f - alpha) * a;
+            }
+            k = alpha > termination ? n : 1;
+        }
+        for (;;) {
             int more = k < n;
             float t = 0.0f;
             if (more) {

@@ -181,6 +181,15 @@ umbra_volume test_volume(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t n
     return test_volume_bricks(ctx, nx, ny, nz, data, 0);
 }
 
+double test_voxel_noise(int i, int j, int k)
+{
+    uint32_t h = (uint32_t)i * 73856093u ^ (uint32_t)j * 19349663u ^ (uint32_t)k * 83492791u;
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    return (double)(h & 0xffffu) / 32767.5 - 1.0;
+}
+
 umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                 const float *data, uint32_t brick_size)
 {

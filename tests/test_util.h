@@ -83,6 +83,9 @@ umbra_renderer test_renderer_transmission(umbra_context ctx, umbra_volume volume
 umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uint32_t nz,
                                 const float *data, uint32_t brick_size);
 
+/* Deterministic per-voxel noise in [-1, 1] (a CT's grain), a hash of the voxel's indices. */
+double test_voxel_noise(int i, int j, int k);
+
 /* A grey transfer function with constant alpha (per voxel) everywhere. */
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha);
 

@@ -52,18 +52,23 @@ inline VolGeom vol_geom(__global const UmbraFrame *F)
     return g;
 }
 
-/* Slab test: the parametric interval [t0, t1] where o + t d lies in [bmin, bmax]; t1 < t0 when
- * the ray misses. Division by a zero component gives +-inf, which the min/max handle, so axis-
- * aligned rays need no special case. */
+/* Slab test: the parametric interval [t0, t1] where o + t d lies in [bmin, bmax] (faces
+ * included); t1 < t0 when the ray misses. Division by a zero component gives +-inf, which the
+ * min/max handle where o lies off that axis' planes. On a plane it gives 0 * inf = NaN for that
+ * plane's bound and the other bound infinite, which fmin/fmax kept: a ray along a face, from a
+ * point on it, missed the box (a point on a side face of a box lit along an axis read fully
+ * lit, issue #29.14). A ray parallel to an axis lies in its slab for every t or for none. */
 inline float2 ray_box(float3 o, float3 d, float3 bmin, float3 bmax)
 {
     float3 inv = 1.0f / d;
     float3 ta = (bmin - o) * inv;
     float3 tb = (bmax - o) * inv;
-    /* A component of d that is exactly zero gives 0 * inf = NaN when o lies on the slab plane;
-     * fmin/fmax drop NaN operands, which treats that axis as unbounded, as it should be. */
     float3 tmin = fmin(ta, tb);
     float3 tmax = fmax(ta, tb);
+    const int3 parallel = d == (float3)(0.0f);
+    const int3 inside = (o >= bmin) & (o <= bmax);
+    tmin = select(tmin, select((float3)(UMBRA_INF), (float3)(-UMBRA_INF), inside), parallel);
+    tmax = select(tmax, select((float3)(-UMBRA_INF), (float3)(UMBRA_INF), inside), parallel);
     float t0 = fmax(fmax(tmin.x, tmin.y), tmin.z);
     float t1 = fmin(fmin(tmax.x, tmax.y), tmax.z);
     return (float2)(t0, t1);

@@ -117,6 +117,21 @@ inline bool ls_base_texel(__global const UmbraShadow *S, float2 xy, int2 *texel)
     return true;
 }
 
+/* Texel t of a point p, kept off the map's rim where p lies in the box. Orthographic and
+ * perspective maps span the box's projection plus one texel's width of margin each side
+ * (host/lightspace.c), so the rim texels' centres, and with them the rays a map marches through
+ * them, lie outside it; a point of the box on a face that runs along the light (or within a few
+ * hundredths of a texel of it, which the rim texels also cover) read the rim's "nothing in the
+ * way" and was fully lit however much of the face lay between it and the light (issue #29.14:
+ * 1.0 where the integral gives 0.389). Such a point takes the nearest texel inside the rim,
+ * whose ray runs half a texel inside the face. An octahedral map has no rim. */
+inline int2 ls_box_texel(__global const UmbraShadow *S, VolGeom g, float3 p, int2 t)
+{
+    if (S->ls_mode == UMBRA_LS_OCTAHEDRAL || any(p < g.box_min) || any(p > g.box_max))
+        return t;
+    return clamp(t, (int2)(1), (int2)((int)S->map_size - 2));
+}
+
 /* How far the taps reach from the sample's texel along x or y (the largest |offset| above). */
 #define LS_TAP_REACH 10
 

@@ -167,19 +167,10 @@ UMBRA_INLINE float voxel_blended(VolGeom g, float b)
 #endif
 }
 
-inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+#if UMBRA_VOLUME_SLABS > 1
+/* The buffer of slab s. */
+UMBRA_INLINE __global const UMBRA_VOXEL_T *volume_slab(VOLUME_PARAM, int s)
 {
-    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
-    /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
-     * negative and huge values), a conversion one. */
-    int3 i0 = convert_int3(x);
-    float3 f = x - convert_float3(i0);
-    int3 i1 = min(i0 + 1, g.dims - 1);
-#if UMBRA_VOLUME_SLABS == 1
-    __global const UMBRA_VOXEL_T *restrict v = vol;
-#else
-    /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
-    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
     __global const UMBRA_VOXEL_T *v = vol_0;
     v = s == 1 ? vol_1 : v;
 #if UMBRA_VOLUME_SLABS > 2
@@ -200,6 +191,24 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 #if UMBRA_VOLUME_SLABS > 7
     v = s == 7 ? vol_7 : v;
 #endif
+    return v;
+}
+#endif
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
+     * negative and huge values), a conversion one. */
+    int3 i0 = convert_int3(x);
+    float3 f = x - convert_float3(i0);
+    int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_VOLUME_SLABS == 1
+    __global const UMBRA_VOXEL_T *restrict v = vol;
+#else
+    /* The slab holding layers i0.z and i1.z (see the top of the file), and the layers in it. */
+    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    __global const UMBRA_VOXEL_T *v = volume_slab(vol, s);
     i0.z -= s * UMBRA_SLAB_STEP;
     i1.z -= s * UMBRA_SLAB_STEP;
 #endif
@@ -211,6 +220,46 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
     float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
     return voxel_blended(g, mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z));
+}
+#endif
+
+/* The eight voxels of the cell of voxel centres whose lowest corner is voxel i0 (i0 in
+ * [0, dims - 2], 0 on an axis of one voxel, where the cell repeats it), as sample_volume reads
+ * and normalises them, x fastest: c[x + 2 y + 4 z]. The trilinear interpolant inside the cell is
+ * then a blend of these (kernels/techniques/reference.cl integrates along a ray cell by cell). */
+#if UMBRA_SAMPLER_IMAGE
+/* Filtered reads at the voxel centres, where the filter's weights are 1 and 0: the texels. */
+UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
+{
+    const int3 i1 = min(i0 + 1, g.dims - 1);
+    for (int k = 0; k < 8; ++k) {
+        const int3 i = (int3)((k & 1) ? i1.x : i0.x, (k & 2) ? i1.y : i0.y, (k & 4) ? i1.z : i0.z);
+        c[k] = sample_volume(vol, g, g.box_min + (convert_float3(i) + 0.5f) * g.spacing);
+    }
+}
+#else
+UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
+{
+    int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_VOLUME_SLABS == 1
+    __global const UMBRA_VOXEL_T *restrict v = vol;
+#else
+    const int s = min(i0.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
+    __global const UMBRA_VOXEL_T *v = volume_slab(vol, s);
+    i0.z -= s * UMBRA_SLAB_STEP;
+    i1.z -= s * UMBRA_SLAB_STEP;
+#endif
+    const size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+    const size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
+    const size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
+    float2 r[4] = {voxel_load2(v, g, z0 + y0 + i0.x), voxel_load2(v, g, z0 + y1 + i0.x),
+                   voxel_load2(v, g, z1 + y0 + i0.x), voxel_load2(v, g, z1 + y1 + i0.x)};
+    for (int k = 0; k < 4; ++k) {
+        /* one voxel along x: the second load is the next row's (or the pad), not this cell's */
+        const float x1 = i1.x == i0.x ? r[k].x : r[k].y;
+        c[2 * k] = voxel_blended(g, r[k].x);
+        c[2 * k + 1] = voxel_blended(g, x1);
+    }
 }
 #endif
 

@@ -807,14 +807,17 @@ inline deep_node deep_fetch(__global const deep_node *nodes, int fixed, size_t t
     return nodes[((size_t)block * K + (size_t)((uint)j % K)) * T2 + (size_t)lane];
 }
 
-inline float3 deep_shadow(__global const UmbraShadow *S, __global const UmbraDeep *D,
-                          __global const deep_node *nodes,
-                          __global const int *head, __global const int *next,
-                          __global const uint *counts, ShadowRay *sr, float3 p)
+inline float3 deep_shadow(__global const UmbraShadow *S, __global const UmbraDeep *D, VolGeom g,
+                          __global const deep_node *nodes, __global const int *head,
+                          __global const int *next, __global const uint *counts, ShadowRay *sr,
+                          float3 p)
 {
     float3 m = ls_world_to_map(S, p);
     int2 t;
-    if (!isfinite(m.z) || !ls_base_texel(S, m.xy, &t) || !ls_fold_texel(S, &t))
+    if (!isfinite(m.z) || !ls_base_texel(S, m.xy, &t))
+        return (float3)(1.0f);
+    t = ls_box_texel(S, g, p, t);
+    if (!ls_fold_texel(S, &t))
         return (float3)(1.0f);
     const int n = (int)S->map_size;
     const int idx = t.y * n + t.x;
@@ -868,4 +871,4 @@ inline float3 deep_shadow(__global const UmbraShadow *S, __global const UmbraDee
 }
 
 #define SHADOW_FACTOR(sr, p)                                                                   \
-    deep_shadow(S, D, deep_nodes, deep_head, deep_next, deep_counts, &(sr), (p))
+    deep_shadow(S, D, g, deep_nodes, deep_head, deep_next, deep_counts, &(sr), (p))

@@ -18,15 +18,36 @@
  *    a gentle decline in front of a cliff is one of the choices.
  *  - The kept nodes are a subset of the fit's, whose visibility never rises and whose depths
  *    never fall, so the stored function is monotone non-increasing and in [0, 1] too.
- * Error of a choice: the sum over its segments of the integral of |buffer - kept| against
- * sqrt(v) dtau (tau the optical depth, v the visibility; trapezoid rule on the buffer's nodes).
- * dtau alone weighs every bit of material alike -- error in empty space costs nothing, so a
- * cliff is never smeared over the skin behind it -- but also weighs material deep in shadow as
- * much as the lit face a camera on the light's side sees; dv = v dtau (the light the material
- * takes out) the other way round. sqrt(v) dtau lies between: measured on tests/test_deep_budget.c
- * at 3 nodes, image RMSE against the reference 0.008 (point light in nested shells) and 0.016
- * (thick shell, oblique light), against 0.008 / 0.020 for dtau, 0.014 / 0.018 for dv, 0.009 /
- * 0.022 for the largest error at any node (greedy) and 0.036 / 0.011 for the old streaming merge.
+ * Error of a choice: the sum over its segments of the integral of |buffer - kept| against a
+ * weight w dtau (tau the optical depth; the buffer and the kept function run linearly between the
+ * buffer's nodes, and so does their difference, whose absolute value is integrated exactly,
+ * through the zero where the kept line crosses the buffer's function). dtau weighs every bit of
+ * material alike -- error in empty space costs nothing, so a cliff is never smeared over the skin
+ * behind it. For a light outside the box w = sqrt(v) (v the visibility): material deep in shadow
+ * counts less than the lit face a camera on the light's side sees (dv = v dtau, the light the
+ * material takes out, would go further). For a light at or inside the box (an octahedral map)
+ * w = 1: a camera outside sees the far ends of the light's rays, the material deepest in the
+ * light's shadow, and an error in the visibility there is as plain as anywhere (a head lit from
+ * inside: sqrt(v) kept the inner table of the skull and read its outer table, the one the camera
+ * sees, up to 0.1 too bright, in rings where the choice changed from ray to ray). There the
+ * greedy fit that feeds the buffer also runs within epsilon / DEEP_FIXED_EPS_DIV, so that the
+ * choice has candidate nodes near where the visibility starts to fall (the fit within epsilon
+ * puts them where the fall leaves its tolerance, up to a step later); the map keeps at most N of
+ * them, and a large budget can then come closer to the reference than the unbounded map. And
+ * the flat stretch behind the material (to the box's far side) costs no node of the budget
+ * (deep_fixed_trim_tail).
+ * Image RMSE against the reference at 3 nodes (tests/test_deep_budget.c, test_deep_fidelity.c,
+ * PoCL): nested shells round a point light 0.010 (0.011 with the trapezoid, sqrt(v), the fit
+ * within epsilon everywhere and the tail's node, before 2026-12-01), a thick shell lit obliquely
+ * 0.010 (0.016), the head phantoms 0.011 and 0.011 (0.028 and 0.026, with 4.7% and 4.2% of their
+ * pixels off by more than 0.1), the spheres with the light inside 0.008 and 0.010 (0.009 and
+ * 0.010; largest pixel error 0.14 and 0.15, the budget's own: 8 nodes 0.055 and 0.043, as the
+ * unbounded map). Earlier measures on the first two: dtau alone 0.008 / 0.020, dv 0.014 / 0.018,
+ * the largest error at any node (greedy) 0.009 / 0.022, the old streaming merge 0.036 / 0.011.
+ * With the rest as now, sqrt(v) for a light inside gives the heads 0.016 / 0.012, dv 0.027. The
+ * exact integral makes the walnut's 3-node build (a point light outside) 1.09x-1.15x as long
+ * (200 x 150, builds of the old and new code in turn), the finer fit the spheres' with the light
+ * inside about 1.3x.
  * Buffer: DEEP_FIXED_BUF nodes; a texel whose fit emits more merges the node of least error
  * (against the buffer as it is then, so such errors add up) while it marches, and before the
  * exact choice (dynamic programming, O(N M^3) for M buffered nodes) the buffer is cut the same
@@ -34,14 +55,17 @@
  * Unused slots repeat the last node; a texel without attenuation stores (0, 1). */
 #define DEEP_FIXED_BUF 64 /* the largest max_nodes host/techniques/deep.c accepts */
 #define DEEP_FIXED_DP 24
+#define DEEP_FIXED_EPS_DIV 4.0f
 
-/* Per buffered node also its optical depth tau and sqrt(v), the two factors of the error's
- * weight: computed once when the node arrives instead of in every span error that covers it (the
- * exact choice evaluates O(M^3) of them, each a logarithm and a square root per channel). */
+/* Per buffered node also its optical depth tau and the weight w (sqrt(v), or 1 where uniform),
+ * the two factors of the error's weight: computed once when the node arrives instead of in every
+ * span error that covers it (the exact choice evaluates O(M^3) of them, each a logarithm and a
+ * square root per channel). */
 typedef struct DeepFixed {
     deep_node n[DEEP_FIXED_BUF];
     light_t tau[DEEP_FIXED_BUF], sq[DEEP_FIXED_BUF];
     int cnt;
+    int uniform; /* w = 1 (a light at or inside the box), else sqrt(v) */
 } DeepFixed;
 
 inline light_t deep_fixed_tau(light_t v) { return -log(fmax(v, (light_t)(1e-6f))); }
@@ -58,17 +82,25 @@ inline light_t deep_fixed_line(const deep_node *n, int a, int b, int l)
 }
 
 /* Error of replacing the buffer between kept nodes a and b (indices into n, a < b; a = -1: no
- * kept node before b) by the line from a to b (by 1 for a = -1), integrated against
- * sqrt(v) dtau from a (error 0 there; tau 0 for a = -1) to b, largest over the channels. */
+ * kept node before b) by the line from a to b (by 1 for a = -1), integrated against w dtau from
+ * a (error 0 there; tau 0 for a = -1) to b, largest over the channels. Between two buffered
+ * nodes the difference runs linearly; where its sign changes, |difference| is two triangles
+ * (the trapezoid of the two ends' |difference| counted a line crossing the buffer's function as
+ * off by that much throughout, and so chose the lines that stay on one side of it). */
 inline float deep_fixed_span_error(const DeepFixed *f, int a, int b)
 {
     const deep_node *n = f->n;
     light_t sum = (light_t)(0.0f), e_prev = (light_t)(0.0f);
     light_t t_prev = a < 0 ? (light_t)(0.0f) : f->tau[a];
     for (int l = a + 1; l <= b; ++l) {
-        light_t e = fabs(DEEP_VIS(n[l]) - deep_fixed_line(n, a, b, l));
-        light_t t = f->tau[l];
-        sum += 0.5f * (e + e_prev) * (t - t_prev) * f->sq[l];
+        const light_t e = DEEP_VIS(n[l]) - deep_fixed_line(n, a, b, l);
+        const light_t t = f->tau[l];
+        const light_t ae = fabs(e), ap = fabs(e_prev);
+        light_t area = 0.5f * (ae + ap);
+        if (light_any_gt((light_t)(0.0f), e * e_prev)) /* a sign change: the zero's two triangles */
+            area = select(area, 0.5f * (ae * ae + ap * ap) / (ae + ap),
+                          e * e_prev < (light_t)(0.0f));
+        sum += area * (t - t_prev) * f->sq[l];
         e_prev = e;
         t_prev = t;
     }
@@ -171,8 +203,30 @@ inline void deep_fixed_add(DeepFixed *f, deep_node e)
     if (f->cnt == DEEP_FIXED_BUF)
         deep_fixed_reduce(f, DEEP_FIXED_BUF - 1);
     f->tau[f->cnt] = deep_fixed_tau(DEEP_VIS(e));
-    f->sq[f->cnt] = sqrt(DEEP_VIS(e));
+    f->sq[f->cnt] = f->uniform ? (light_t)(1.0f) : sqrt(DEEP_VIS(e));
     f->n[f->cnt++] = e;
+}
+
+/* A light at or inside the box: the buffer's last nodes that lie within tol of the end value
+ * (the flat stretch from the material's far side to the box's) become one node at the first of
+ * them, holding the end value, so that the budget does not spend a node on the flat stretch
+ * (a point light among the spheres: 3 nodes then cover a sphere with two lines, not one). The
+ * function moves by at most tol there and still never rises; the first node stays. */
+inline void deep_fixed_trim_tail(DeepFixed *f, float tol)
+{
+    const int m = f->cnt;
+    if (m < 3)
+        return;
+    const light_t v_end = DEEP_VIS(f->n[m - 1]);
+    int k = m - 1;
+    while (k > 1 && !light_any_gt(DEEP_VIS(f->n[k - 1]) - v_end, (light_t)(tol)))
+        --k;
+    if (k == m - 1)
+        return;
+    f->n[k] = DEEP_NODE(DEEP_DEPTH(f->n[k]), v_end);
+    f->tau[k] = f->tau[m - 1];
+    f->sq[k] = f->sq[m - 1];
+    f->cnt = k + 1;
 }
 
 __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
@@ -197,11 +251,18 @@ __kernel void deep_build_fixed(__global const UmbraFrame *F, VOLUME_PARAM,
     deep_node e[DEEP_MAX_EMIT];
     DeepFixed fx;
     fx.cnt = 0;
+    /* A light at or inside the box: w = 1, and candidates from a finer fit (the march still
+     * stops where the unbounded map's does, so the end value is the same). */
+    fx.uniform = S->ls_mode == UMBRA_LS_OCTAHEDRAL;
+    if (fx.uniform)
+        st.eps = eps / DEEP_FIXED_EPS_DIV;
     while (!st.done) {
         int ne = deep_step(&st, F, vol, g, light_tf, light_cells, S, lut, use_lut, e);
         for (int q = 0; q < ne; ++q)
             deep_fixed_add(&fx, e[q]);
     }
+    if (fx.uniform && fx.cnt > N)
+        deep_fixed_trim_tail(&fx, st.eps);
     if (fx.cnt > N) {
         deep_fixed_reduce(&fx, N < DEEP_FIXED_DP ? DEEP_FIXED_DP : N);
         if (N < DEEP_FIXED_DP)

@@ -1,47 +1,53 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/techniques/reference.cl: the exact reference. From every point, a shadow ray is marched
- * toward the light with step S->step and the optical depth of the shading model (the extinction
- * per channel of kernels/common/common.cl) is integrated. Every other technique is measured against
- * it.
+/* kernels/techniques/reference.cl: the exact reference. From every point, a shadow ray toward
+ * the light, along which the optical depth of the shading model (the extinction per channel of
+ * kernels/common/common.cl) is integrated. Every other technique is measured against it.
  *
- * Quadrature. The path [t_start, t_end] inside the volume (and before a point light) is split
- * into whole steps h plus one final partial step; the volume is sampled at the ends of every
- * segment, so the first sample is the point itself (a point just inside the lit face of a sheet
- * sees the material between it and the face, which a midpoint rule misses for up to h/2). Along a
- * segment the value is taken to run linearly between its two end samples, and the segment's
- * optical depth is integrated through the transfer function in value space, exactly: the value
- * interval is split at the table's entries, where the interpolated opacity has its kinks; across
- * one table interval the opacity and the colour run linearly, so the extinction integrates in
- * closed form (piece_depth: at most two logs, none on an opacity plateau, the entries'
- * extinctions coming from the host), and the whole intervals between come from per-interval
- * integrals the host computed in the same closed form in double (host/tables.c, appended to the
- * light table as compensated prefix sums). A sharp transfer-function edge therefore costs no
- * accuracy beyond the linearity of the value along one segment, and where the extinction varies
- * along a segment it is split further (segment_refined): at the interpolant's kinks, then at its
- * middle, keeping a split's halves and refining no further where they agree with the whole to
- * 3e-5 of depth, with thresholds relative to the light the segment still receives. A homogeneous
- * medium gives exp(-sigma d) for every h. Measured against an independent float64 integral
- * (tests/test_fidelity.c) at h = 0.25: 2e-6 on a one-voxel sheet under a step transfer function
- * (1.4e-4 with the Gauss rule), 3.7e-4 on a near-singular ramp (5e-4), 1.8e-4 at random points in
- * a structured volume (mean 9e-6). Bonsai (384^2): the reference at step 0.25 against 0.125, RMSE
- * 1e-5, max 8.5e-4. The price is time. Same-session frames (PoCL, 2 loaded cores): bonsai 64^2
- * 6.8 / 5.8 s with the Gauss rule, 1.3 / 1.7 s now (4.2x); Marschner-Lobb 64^3 at 256^2 8.2 / 9.2 s,
- * 6.0 / 5.3 s (1.55x: its rippled isosurface keeps most split candidates refining). Without any
- * refinement either frame costs about 40% of that. Against the old midpoint rule (1/27 of the
- * Gauss rule's bonsai frame, 1/11 of Marschner-Lobb's, measured before) that makes about 6x and
- * 7x. Thresholds of 4e-3 (kinks) and 1.6e-2 (middles) broke the ramp's and the structured volume's
- * bounds; an agreement tolerance of 1e-4 brought the structured volume to 2.7e-4 of its 3e-4, 3e-5
- * costs 20% less than 1e-5 on Marschner-Lobb and hardly anything on the bonsai, whose split
- * candidates are mostly resolved by their first split. The depths are summed (Kahan-compensated)
- * and exponentiated once, so a thin medium keeps its precision at any step
- * (1e-6 per voxel over 512 voxels at step 0.01). The march stops once every channel is below
- * 1e-6.
+ * Quadrature. The path [t_start, t_end] inside the volume (and before a point light) is walked
+ * cell by cell of voxel centres. Inside a cell the trilinear interpolant is one blend of the
+ * cell's eight voxels, a cubic along the ray (RayCell, read with one load of the eight); its
+ * kinks lie on the cell's faces, where the walk cuts the path, so a kink on a step's boundary or
+ * in its middle is integrated like any other. Each cell's part is cut further at the steps of
+ * h = S->step from the point (the first piece starts at the point itself: a point just inside a
+ * sheet's lit face sees the material between it and the face) and at the cubic's extrema, so
+ * that along every piece the value runs smoothly and monotonically from va to vb. A piece's
+ * optical depth is first integrated through the transfer function in value space as if the
+ * value ran linearly, exactly: the value interval is split at the table's entries, where the
+ * interpolated opacity has its kinks; across one table interval the opacity and the colour run
+ * linearly, so the extinction integrates in closed form (piece_depth: at most two logs, none on
+ * an opacity plateau, the entries' extinctions coming from the host), and the whole intervals
+ * between come from per-interval integrals the host computed in the same closed form in double
+ * (host/tables.c, appended to the light table as compensated prefix sums). The value's curve
+ * departs from that line (inside a cell crossed obliquely) by v - chord, known in closed form
+ * from the cubic: its integral times the extinction's secant slope over the piece's values is
+ * added, which is exact where the extinction runs linearly over them (piece_depth_curved); where
+ * what that can leave (a transfer-function edge inside the piece's values) exceeds 1e-4 of depth,
+ * the piece is halved, and halved again where the halves differ from the whole by more than
+ * 3e-5 (piece_refined), thresholds relative to the light the piece still receives. A homogeneous
+ * medium gives exp(-sigma d) for every h, and a value linear along each piece (light along an
+ * axis) is integrated exactly. The depths are summed (Kahan-compensated) and exponentiated once,
+ * so a thin medium keeps its precision at any step (1e-6 per voxel over 512 voxels at step 0.01).
+ * The march stops once every channel is below 1e-6.
  *
- * Empty-space skipping: the ray walks the light's sub-cell masks; a segment whose two ends lie in
- * cells the light transfer function leaves empty is skipped, the one ending in a visible cell is
- * integrated from its invisible start. (A visible cell crossed between two samples in invisible
- * cells, possible only where it holds no sample, is skipped: skipping can change a value only
- * there.) */
+ * Measured against an independent float64 integral (tests/test_fidelity.c, test_alignment.c):
+ * at h = 0.25, 2.9e-6 on a one-voxel sheet under a step transfer function, 2.8e-7 on a
+ * near-singular ramp, 2.9e-5 at random points in a structured volume (mean 3.5e-7); kinks placed
+ * on steps' boundaries and middles, and random voxels under a light on a lattice point, 4e-6 at
+ * every step from 1/16 to 1. Until 2026-12-01 the volume was sampled at the steps' ends and a
+ * step split at the one kink nearest its middle, only where the extinction at its two ends
+ * differed: a peak centred on a step, whose ends then have one value, was missed whole (issue
+ * #29: 0.027 at step 0.25, 0.17 at step 1), and the structured volume was off by 1.8e-4. The
+ * cost, frames of the old and the new reference in turn (PoCL on the 2-core machine while other
+ * builds ran, so the process's CPU time per frame, medians of 3 after a warm-up): the walnut at
+ * 200 x 150, 1.04x and 0.94x the old frame; the spheres (128^3) at 192^2, 1.05x and 1.06x. The
+ * walk's one load of eight voxels per cell replaces a trilinear sample per step: without the
+ * correction and the refinement a frame takes 0.8x; refining every candidate down to 3e-5
+ * instead of stopping where the halves agree took 1.9x, a candidate threshold of 3e-5 instead
+ * of 1e-4 1.2x (the structured volume at 1.2e-5).
+ *
+ * Empty-space skipping: the ray walks the light's sub-cell masks too and integrates only inside
+ * visible sub-cells: in an invisible one the light transfer function leaves every value the
+ * interpolant takes transparent, so skipping changes no depth. */
 
 #define SHADOW_KERNEL_PARAMS
 
@@ -91,15 +97,17 @@ inline float2 log_moments(float r, float om_r, float lr)
  * opacities are clamped to UMBRA_ALPHA_MAX before, not after, the interpolation between them,
  * which differs from tf_extinction only where the table reaches opacity 1, over 2^-24 of an
  * interval. The range of the extinction over the piece (its two ends: it is monotonic in a)
- * widens lo, hi. At most two logs (none on a plateau of the opacity, one where an end lies on a
- * table entry), where three-point Gauss took three and three table lookups. */
+ * widens lo, hi; *ext_a, *ext_b get the extinctions at a and b. At most two logs (none on a
+ * plateau of the opacity, one where an end lies on a table entry), where three-point Gauss took
+ * three and three table lookups. */
 inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, uint flags,
-                           float *lo, float *hi)
+                           float *lo, float *hi, light_t *ext_a, light_t *ext_b)
 {
     const int i = min((int)a, (int)n - 2);
     const float4 c0 = tf[i], c1 = tf[i + 1];
     if (c0.w == 0.0f && c1.w == 0.0f) { /* transparent: the common case, no logs */
         *lo = 0.0f;
+        *ext_a = *ext_b = (light_t)(0.0f);
         return (light_t)(0.0f);
     }
     /* The ends, and their extinctions: an end on a table entry (or a plateau of the opacity)
@@ -116,6 +124,8 @@ inline light_t piece_depth(__global const float4 *tf, uint n, float a, float b, 
     const float se = up ? sa : sb, so = up ? sb : sa;
     const light_t fe = light_absorbed(ce, flags), fo = light_absorbed(co, flags);
     const light_t de = se * fe, dob = so * fo;
+    *ext_a = up ? de : dob;
+    *ext_b = up ? dob : de;
     *lo = fmin(*lo, fmin(light_min(de), light_min(dob)));
     *hi = fmax(*hi, fmax(light_max(de), light_max(dob)));
     if (co.w == ce.w) /* a constant opacity: the colour's mean */
@@ -137,25 +147,28 @@ inline float4 interval_sum(__global const float4 *tf, uint n, int k, int j)
  * linearly from v0 to v1: len times the mean extinction over [v0, v1] of the light table
  * (n entries): the partial table intervals at the ends by three-point Gauss, the whole ones
  * between from the host's exact interval sums. *spread: how much the extinction varies over the
- * range (the Gauss nodes and the whole intervals' mean), times len. */
+ * range (the ends' extinctions and the whole intervals' mean), times len; *ext0, *ext1: the
+ * extinctions per voxel at v0 and v1. */
 inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float v1, float len,
-                             uint flags, float *spread)
+                             uint flags, float *spread, light_t *ext0, light_t *ext1)
 {
     const float last = (float)(n - 1);
     const float x0 = clamp(fmin(v0, v1), 0.0f, 1.0f) * last;
     const float x1 = clamp(fmax(v0, v1), 0.0f, 1.0f) * last;
     const float span = x1 - x0;
     *spread = 0.0f;
-    if (!(span > 0.0f))
-        return light_depth(tf_lookup(tf, n, x0 / last), len, flags);
+    if (!(span > 0.0f)) {
+        *ext0 = *ext1 = light_depth(tf_lookup(tf, n, x0 / last), 1.0f, flags);
+        return *ext0 * len;
+    }
     const int i0 = min((int)x0, (int)n - 2), i1 = min((int)x1, (int)n - 2);
     float lo = UMBRA_INF, hi = 0.0f;
-    light_t sum;
+    light_t sum, e_lo, e_hi, e_mid;
     if (i0 == i1) {
-        sum = piece_depth(tf, n, x0, x1, flags, &lo, &hi);
+        sum = piece_depth(tf, n, x0, x1, flags, &lo, &hi, &e_lo, &e_hi);
     } else {
-        sum = piece_depth(tf, n, x0, (float)(i0 + 1), flags, &lo, &hi) +
-              piece_depth(tf, n, (float)i1, x1, flags, &lo, &hi);
+        sum = piece_depth(tf, n, x0, (float)(i0 + 1), flags, &lo, &hi, &e_lo, &e_mid) +
+              piece_depth(tf, n, (float)i1, x1, flags, &lo, &hi, &e_mid, &e_hi);
         if (i1 > i0 + 1) {
             const float4 w = interval_sum(tf, n, i0 + 1, i1);
 #if UMBRA_LIGHT_CHANNELS == 1
@@ -170,118 +183,178 @@ inline light_t segment_depth(__global const float4 *tf, uint n, float v0, float 
         }
     }
     *spread = (hi - lo) * len;
+    *ext0 = v0 <= v1 ? e_lo : e_hi;
+    *ext1 = v0 <= v1 ? e_hi : e_lo;
     return sum * (len / span);
 }
 
-/* Along one axis, the parameter t in (ta, tb) at which the ray x(t) = xo + t xd (voxel
- * coordinates) crosses a plane of voxel centres inside the grid [0, dim - 1], the one nearest
- * tm, or -1 if it crosses none away from the ends (the trilinear interpolant has its kinks on
- * those planes). */
-inline float seg_kink_axis(float xo, float xd, int dim, float ta, float tb, float tm)
+/* ---- the ray inside one cell of voxel centres ----------------------------------------------
+ * Between two planes of voxel centres on every axis the trilinear interpolant is one blend of the
+ * cell's eight voxels, so along the ray it is a cubic in t: v(t0 + s) = v(t0) + k1 s + k2 s^2 +
+ * k3 s^3. Its kinks lie on the cell's faces, its extrema (at most two) where 3 k3 s^2 + 2 k2 s +
+ * k1 = 0. An axis on which the ray lies outside the grid (the half voxel at the box's faces,
+ * where the sampler clamps) or which has one voxel leaves the interpolant constant along it. */
+typedef struct RayCell {
+    float c[8];        /* the voxels, x fastest (volume_cell) */
+    float3 p, q;       /* the local coordinates u = clamp(p + q (t - t0), 0, 1) in the cell */
+    float t0;
+    float k1, k2, k3;  /* the cubic in s = t - t0 */
+} RayCell;
+
+/* The cell j of the ray xo + t xd (voxel coordinates): per axis between the planes of voxel
+ * centres j and j + 1, j in [-1, dims - 1] (-1 before the first plane, dims - 1 past the last). */
+inline void ray_cell_load(VOLUME_PARAM, VolGeom g, int3 j, float3 xo, float3 xd, float t0,
+                          RayCell *C)
 {
-    if (xd == 0.0f)
-        return -1.0f;
-    const float x0 = xo + ta * xd, x1 = xo + tb * xd;
-    const float lo = fmax(fmin(x0, x1), 0.0f), hi = fmin(fmax(x0, x1), (float)(dim - 1));
-    const float c = clamp(rint(xo + tm * xd), ceil(lo), floor(hi));
-    if (!(c >= lo && c <= hi))
-        return -1.0f;
-    const float t = (c - xo) / xd, margin = 1e-3f * (tb - ta);
-    return (t > ta + margin && t < tb - margin) ? t : -1.0f;
+    const int3 i0 = clamp(j, (int3)(0), max(g.dims - 2, (int3)(0)));
+    volume_cell(vol, g, i0, C->c);
+    const int3 inside = (j >= (int3)(0)) & (j <= g.dims - 2);
+    const float3 outside_u = select((float3)(0.0f), (float3)(1.0f), j >= (int3)(0));
+    const float3 p = select(outside_u, xo + t0 * xd - convert_float3(i0), inside);
+    const float3 q = select((float3)(0.0f), xd, inside);
+    C->p = p;
+    C->q = q;
+    C->t0 = t0;
+    const float *c = C->c;
+    const float bx = c[1] - c[0], by = c[2] - c[0], bz = c[4] - c[0];
+    const float cxy = c[3] - c[2] - c[1] + c[0], cxz = c[5] - c[4] - c[1] + c[0];
+    const float cyz = c[6] - c[4] - c[2] + c[0];
+    const float d = c[7] - c[6] - c[5] - c[3] + c[4] + c[2] + c[1] - c[0];
+    C->k1 = bx * q.x + by * q.y + bz * q.z + cxy * (p.x * q.y + q.x * p.y) +
+            cxz * (p.x * q.z + q.x * p.z) + cyz * (p.y * q.z + q.y * p.z) +
+            d * (q.x * p.y * p.z + p.x * q.y * p.z + p.x * p.y * q.z);
+    C->k2 = cxy * q.x * q.y + cxz * q.x * q.z + cyz * q.y * q.z +
+            d * (q.x * q.y * p.z + q.x * p.y * q.z + p.x * q.y * q.z);
+    C->k3 = d * q.x * q.y * q.z;
 }
 
-/* The kink of the three axes' nearest the middle of (ta, tb), or -1. */
-inline float seg_kink(VolGeom g, float3 xo, float3 xd, float ta, float tb)
+/* The interpolant at t in the cell: sample_volume's blend of the cell's voxels. */
+inline float ray_cell_value(const RayCell *C, float t)
 {
-    const float tm = 0.5f * (ta + tb);
-    const float k[3] = {seg_kink_axis(xo.x, xd.x, g.dims.x, ta, tb, tm),
-                        seg_kink_axis(xo.y, xd.y, g.dims.y, ta, tb, tm),
-                        seg_kink_axis(xo.z, xd.z, g.dims.z, ta, tb, tm)};
-    float best = -1.0f;
-    for (int a = 0; a < 3; ++a)
-        if (k[a] >= 0.0f && (best < 0.0f || fabs(k[a] - tm) < fabs(best - tm)))
-            best = k[a];
-    return best;
+    const float3 u = clamp(C->p + C->q * (t - C->t0), 0.0f, 1.0f);
+    const float c00 = mix(C->c[0], C->c[1], u.x), c10 = mix(C->c[2], C->c[3], u.x);
+    const float c01 = mix(C->c[4], C->c[5], u.x), c11 = mix(C->c[6], C->c[7], u.x);
+    return mix(mix(c00, c10, u.y), mix(c01, c11, u.y), u.z);
 }
 
-/* The optical depth of the segment [ta, tb] of the ray p + t d (len voxels long, per_t voxels per
- * unit of t; xo, xd the ray in voxel coordinates) whose ends have the values va, vb, behind
- * d_before of optical depth (the least over the channels) on the way to the light:
- * segment_depth, refined where the value's departure from a straight line within the segment
- * would shift the extinction. A piece is a candidate for a split at a new sample
- *  - where the ray crosses a plane of voxel centres (the trilinear interpolant's kinks, an error
- *    of first order in the piece's length) and the extinction varies along the piece by more
- *    than SEG_KINK_DEPTH of optical depth, at that crossing: past the kinks the pieces are smooth,
- *    and a value linear in space along an axis is integrated exactly;
- *  - else, where it varies by more than SEG_REFINE_DEPTH (the interpolant's curvature, an error
- *    of second order), at the middle;
- * and the split is taken: the two halves' depths replace the piece's. Where those differ from it
- * by more than SEG_REFINE_TOL in some channel, each half is a candidate in turn (depth-first,
- * with an explicit stack, at most SEG_REFINE_LEVELS deep); where they agree, the halves are
- * kept and the refinement stops there: most candidates are smooth pieces over a steep part of
- * the transfer function, which the first split already shows to be resolved. The three
- * thresholds are multiplied by exp(d_before): an error e in this segment's depth moves the
- * shadow factor by at most e exp(-d_before), so each stands for the same error in the factor,
- * which is what the bounds and the images measure, wherever the segment lies. */
+/* The interpolant's extrema along the ray in the cell, as t (UMBRA_INF where there is none),
+ * the smaller first. */
+inline float2 ray_cell_extrema(const RayCell *C)
+{
+    const float a = 3.0f * C->k3, b = 2.0f * C->k2, c = C->k1;
+    float r0 = UMBRA_INF, r1 = UMBRA_INF;
+    if (a == 0.0f) {
+        if (b != 0.0f)
+            r0 = -c / b;
+    } else {
+        const float disc = b * b - 4.0f * a * c;
+        if (disc >= 0.0f) {
+            const float qq = -0.5f * (b + copysign(sqrt(disc), b));
+            r0 = qq / a;
+            r1 = qq != 0.0f ? c / qq : UMBRA_INF;
+        }
+    }
+    const float lo = fmin(r0, r1), hi = fmax(r0, r1);
+    return (float2)(C->t0 + lo, hi < UMBRA_INF ? C->t0 + hi : UMBRA_INF);
+}
+
+/* How far the interpolant departs from the straight line between its values at ta and tb
+ * (within one cell), at most: v(t) - chord(t) = (t - ta) (t - tb) (k2 + k3 (sa + sb + s)). */
+inline float ray_cell_bend(const RayCell *C, float ta, float tb)
+{
+    const float sa = ta - C->t0, sb = tb - C->t0, l = tb - ta;
+    return 0.25f * l * l *
+           fmax(fabs(C->k2 + C->k3 * (2.0f * sa + sb)), fabs(C->k2 + C->k3 * (sa + 2.0f * sb)));
+}
+
+/* The integral of v(t) - chord(t) over [ta, tb]: -(l^3 / 6) (k2 + 3/2 k3 (sa + sb)). */
+inline float ray_cell_bend_integral(const RayCell *C, float ta, float tb)
+{
+    const float sa = ta - C->t0, sb = tb - C->t0, l = tb - ta;
+    return (-1.0f / 6.0f) * l * l * l * (C->k2 + 1.5f * C->k3 * (sa + sb));
+}
+
+/* The optical depth of the piece [ta, tb] of the ray inside cell C, between two of its kinks,
+ * extrema or step boundaries, so that its value runs monotonically from va to vb (per_t voxels
+ * per unit of t). segment_depth takes the value to run linearly; the value's curve departs from
+ * that line by v - chord (ray_cell_bend at most), which moves the depth by about the extinction's
+ * slope in value times the integral of v - chord: that is added, with the slope taken as the
+ * secant between the ends' extinctions (exact where the extinction runs linearly over the
+ * piece's values, second order in its curvature); where it could not move the depth by
+ * SEG_CORRECT_TOL it is left out. *err: what the correction leaves at most where the extinction
+ * is not linear there (a transfer-function edge inside the range): its spread over the piece
+ * times the fraction of the piece by which the curve departs from the line. */
+#define SEG_CORRECT_TOL 1e-7f
+inline light_t piece_depth_curved(const RayCell *C, __global const float4 *tf, uint n, uint flags,
+                                  float ta, float tb, float va, float vb, float per_t,
+                                  float *err)
+{
+    float spread;
+    light_t ext_a, ext_b;
+    light_t dd = segment_depth(tf, n, va, vb, (tb - ta) * per_t, flags, &spread, &ext_a, &ext_b);
+    const float dv = vb - va, bent = spread * ray_cell_bend(C, ta, tb);
+    *err = 0.0f;
+    if (bent > SEG_CORRECT_TOL * fabs(dv)) {
+        *err = bent / fabs(dv);
+        dd += (ext_b - ext_a) * (ray_cell_bend_integral(C, ta, tb) * per_t / dv);
+    }
+    return dd;
+}
+
+/* The optical depth of a piece (piece_depth_curved), behind d_before of optical depth (the least
+ * over the channels) on the way to the light, refined where the estimate of its error exceeds
+ * SEG_REFINE_CAND: the piece is halved at its middle (its value from the cell's voxels, no load)
+ * and the halves' depths replace it; where they differ from it by more than SEG_REFINE_TOL,
+ * each half is a candidate in turn (depth-first, an explicit stack, at most SEG_REFINE_LEVELS
+ * deep); where they agree, the refinement stops there (most candidates lie over a part of the
+ * transfer function where the correction is already good). Both thresholds are multiplied by
+ * exp(d_before): an error e in this piece's depth moves the shadow factor by at most
+ * e exp(-d_before), so each stands for the same error in the factor wherever the piece lies. */
 #define SEG_REFINE_LEVELS 3
-#define SEG_REFINE_DEPTH 4e-3f
-#define SEG_KINK_DEPTH 1e-3f
+#define SEG_REFINE_CAND 1e-4f
 #ifndef SEG_REFINE_TOL
 #define SEG_REFINE_TOL 3e-5f
 #endif
-inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *tf, uint n,
-                               uint flags, float3 p, float3 d, float3 xo, float3 xd, float ta,
-                               float tb, float va, float vb, float len, float per_t,
-                               float d_before)
+inline light_t piece_refined(const RayCell *C, __global const float4 *tf, uint n, uint flags,
+                             float ta, float tb, float va, float vb, float per_t,
+                             float d_before)
 {
-    /* The pieces still to do after the current one: their ends, values at the ends, lengths,
-     * depths, spreads and levels (each starts where the one above it ends). A split divides a
-     * piece's length in voxels between its halves, so that they add up to the segment's. */
-    float st_t[SEG_REFINE_LEVELS], st_v[SEG_REFINE_LEVELS], st_s[SEG_REFINE_LEVELS];
-    float st_len[SEG_REFINE_LEVELS];
+    /* The pieces still to do after the current one: their ends, values at the ends, depths,
+     * error estimates and levels (each starts where the one above it ends). */
+    float st_t[SEG_REFINE_LEVELS], st_v[SEG_REFINE_LEVELS], st_e[SEG_REFINE_LEVELS];
     light_t st_d[SEG_REFINE_LEVELS];
     int st_l[SEG_REFINE_LEVELS];
     int top = -1, level = 0;
-    float spread;
-    light_t dd = segment_depth(tf, n, va, vb, len, flags, &spread);
+    float err;
+    light_t dd = piece_depth_curved(C, tf, n, flags, ta, tb, va, vb, per_t, &err);
     light_t D = (light_t)(0.0f);
-    /* The thresholds in optical depth, scaled by the transmittance the light keeps to the
-     * segment (exp of d_before, computed where first needed). */
-    float scale = 0.0f;
+    float scale = 0.0f; /* exp(d_before), computed where first needed */
     for (;;) {
-        /* The current piece: [ta, tb], len voxels, values va, vb, depth dd and its spread. */
-        float tm = -1.0f;
-        if (level < SEG_REFINE_LEVELS && spread > SEG_KINK_DEPTH) {
+        if (level < SEG_REFINE_LEVELS && err > SEG_REFINE_CAND) {
             if (scale == 0.0f)
                 scale = exp(d_before);
-            if (spread > SEG_KINK_DEPTH * scale) {
-                tm = seg_kink(g, xo, xd, ta, tb);
-                if (tm < 0.0f && spread > SEG_REFINE_DEPTH * scale)
-                    tm = 0.5f * (ta + tb);
+            if (err > SEG_REFINE_CAND * scale) {
+                const float tm = 0.5f * (ta + tb), vm = ray_cell_value(C, tm);
+                float e_l, e_r;
+                const light_t d_l =
+                    piece_depth_curved(C, tf, n, flags, ta, tm, va, vm, per_t, &e_l);
+                const light_t d_r =
+                    piece_depth_curved(C, tf, n, flags, tm, tb, vm, vb, per_t, &e_r);
+                if (light_max(fabs(d_l + d_r - dd)) > SEG_REFINE_TOL * scale) {
+                    ++top;
+                    st_t[top] = tb;
+                    st_v[top] = vb;
+                    st_d[top] = d_r;
+                    st_e[top] = e_r;
+                    st_l[top] = ++level;
+                    tb = tm;
+                    vb = vm;
+                    dd = d_l;
+                    err = e_l;
+                    continue;
+                }
+                dd = d_l + d_r;
             }
-        }
-        if (tm >= 0.0f) {
-            const float vm = sample_volume(vol, g, p + tm * d);
-            const float len_l = clamp((tm - ta) * per_t, 0.0f, len), len_r = len - len_l;
-            float s_l, s_r;
-            const light_t d_l = segment_depth(tf, n, va, vm, len_l, flags, &s_l);
-            const light_t d_r = segment_depth(tf, n, vm, vb, len_r, flags, &s_r);
-            if (light_max(fabs(d_l + d_r - dd)) > SEG_REFINE_TOL * scale) {
-                ++top;
-                st_t[top] = tb;
-                st_v[top] = vb;
-                st_len[top] = len_r;
-                st_d[top] = d_r;
-                st_s[top] = s_r;
-                st_l[top] = ++level;
-                tb = tm;
-                vb = vm;
-                len = len_l;
-                dd = d_l;
-                spread = s_l;
-                continue;
-            }
-            dd = d_l + d_r;
         }
         D += dd;
         if (top < 0)
@@ -290,9 +363,8 @@ inline light_t segment_refined(VOLUME_PARAM, VolGeom g, __global const float4 *t
         va = vb;
         tb = st_t[top];
         vb = st_v[top];
-        len = st_len[top];
         dd = st_d[top];
-        spread = st_s[top];
+        err = st_e[top];
         level = st_l[top];
         --top;
     }
@@ -349,6 +421,12 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     return light_rgb(exp(-D));
 }
 #else
+/* The exact reference's shadow ray from p: the path [t_start, t_end] inside the box (and before
+ * a point light) walked cell by cell of voxel centres, each cell's part cut at the steps of h
+ * from p and at the interpolant's extrema, every piece integrated by piece_refined. With
+ * skipping, the ray walks the light's sub-cell masks (CellWalk) too and integrates only inside
+ * visible sub-cells: elsewhere the light transfer function leaves every value the interpolant
+ * takes transparent, so nothing is lost. */
 inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
                                __global const float4 *light_tf,
                                __global const ulong *light_cells,
@@ -363,60 +441,77 @@ inline float3 reference_shadow(__global const UmbraFrame *F, VOLUME_PARAM, VolGe
     if (!(t_end > t_start))
         return (float3)(1.0f);
     const float h = S->step;
-    /* A whole step is h_vox voxels long, the final partial one h_vox last / h; the pieces of
-     * a refined step divide its length at per_t voxels per unit of t (the final step's length in
-     * t, t_end - t_k, can round to 0 where last does not: dividing by it gave 0 / 0, a NaN
-     * pixel). */
-    const float h_vox = light_step_voxels(F, S), per_t = h_vox / h;
+    const float per_t = light_step_voxels(F, S) / h; /* voxels per unit of t */
     const uint n_tf = F->light_tf_size;
     const uint flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
-    const float len = t_end - t_start;
-    const int n_full = (int)floor(len / h);
-    const float last = len - (float)n_full * h;
-    const float3 xo = world_to_voxel(g, p), xd = d * g.inv_spacing;
+    const float3 xo = world_to_voxel(g, p), xd = d * g.inv_spacing, inv_xd = 1.0f / xd;
+    const int3 dir = select(select((int3)(0), (int3)(-1), xd < 0.0f), (int3)(1), xd > 0.0f);
     /* Optical depth, with its Kahan compensation. */
     light_t D = (light_t)(0.0f), comp = (light_t)(0.0f);
-    /* Samples at t_start + k h, k = 0 .. n_full; v_k holds the value of sample k_have. */
-    float v_k = 0.0f;
-    int k_have = -1;
-    /* The ray walks the cells of the light's cell masks (CellWalk); samples before t_cell lie in
-     * a cell already found visible. */
     CellWalk w = walk_begin(g, p, d, t_start);
-    float t_cell = -UMBRA_INF;
-    for (int k = 0; k < n_full;) {
-        if (skip && t_start + (float)k * h >= t_cell) {
-            /* The first sample at or after k in a visible cell; the segment ending there
-             * starts at the sample before it. */
-            int kv = walk_next_sample(&w, g, light_cells, t_start, h, 0.0f, k, n_full + 1, t_end,
-                                      &t_cell);
-            if (kv > n_full)
+    float t = t_start;
+    int k = 1;            /* the next step boundary: t_start + k h */
+    int3 j = (int3)(0);   /* the cell of voxel centres at t, */
+    int have_j = 0;       /* once found (again after a skip) */
+    while (t < t_end) {
+        /* The end of the stretch to integrate: the visible sub-cell's exit, or the ray's. */
+        float t_vis = t_end;
+        if (skip) {
+            const float t_in = walk_to_visible(&w, g, light_cells, t, t_end);
+            if (!(t_in < t_end))
                 break;
-            k = max(k, kv - 1);
+            if (t_in > t) {
+                t = t_in;
+                have_j = 0;
+            }
+            t_vis = fmin(walk_exit(&w), t_end);
         }
-        if (k_have != k)
-            v_k = sample_volume(vol, g, p + (t_start + (float)k * h) * d);
-        const float v_next = sample_volume(vol, g, p + (t_start + (float)(k + 1) * h) * d);
-        const float ta = t_start + (float)k * h;
-        const light_t y = segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, ta, ta + h,
-                                          v_k, v_next, h_vox, per_t, light_min(D)) - comp;
-        const light_t s = D + y;
-        comp = (s - D) - y;
-        D = s;
-        if (light_min(D) > 13.815511f) /* -ln(1e-6) */
-            return (float3)(0.0f);
-        v_k = v_next;
-        k_have = ++k;
-    }
-    /* The final partial segment, always integrated: skipping above may stop at a sample in an
-     * invisible cell before a visible one at the box face. */
-    if (last > 0.0f) {
-        const float t_k = t_start + (float)n_full * h;
-        if (k_have != n_full)
-            v_k = sample_volume(vol, g, p + t_k * d);
-        const float v_end = sample_volume(vol, g, p + t_end * d);
-        D += segment_refined(vol, g, light_tf, n_tf, flags, p, d, xo, xd, t_k, t_end, v_k, v_end,
-                             last * per_t, per_t, light_min(D)) - comp;
+        if (!have_j) {
+            j = clamp(floor_int3(xo + t * xd), (int3)(-1), g.dims - 1);
+            k = max(k, (int)floor((t - t_start) / h) + 1);
+            have_j = 1;
+        }
+        while (t < t_vis) {
+            /* Where the ray leaves cell j: the next plane of voxel centres per axis. */
+            const int3 plane = select(j, j + 1, dir > 0);
+            const int3 has = (dir != 0) & (plane >= (int3)(0)) & (plane <= g.dims - 1);
+            const float3 te = select((float3)(UMBRA_INF), (convert_float3(plane) - xo) * inv_xd,
+                                     has);
+            const float t_face = fmin(fmin(te.x, te.y), te.z);
+            const float t_out = fmin(t_face, t_vis);
+            RayCell C;
+            ray_cell_load(vol, g, j, xo, xd, t, &C);
+            const float2 ext = ray_cell_extrema(&C);
+            float ta = t, va = ray_cell_value(&C, t);
+            while (ta < t_out) {
+                float tk = t_start + (float)k * h;
+                while (!(tk > ta)) /* rounding, or a cell shorter than a step */
+                    tk = t_start + (float)(++k) * h;
+                float tn = fmin(t_out, tk);
+                if (ext.x > ta && ext.x < tn)
+                    tn = ext.x;
+                else if (ext.y > ta && ext.y < tn)
+                    tn = ext.y;
+                const float vn = ray_cell_value(&C, tn);
+                const light_t y = piece_refined(&C, light_tf, n_tf, flags, ta, tn, va, vn, per_t,
+                                                light_min(D)) - comp;
+                const light_t s = D + y;
+                comp = (s - D) - y;
+                D = s;
+                if (light_min(D) > 13.815511f) /* -ln(1e-6) */
+                    return (float3)(0.0f);
+                ta = tn;
+                va = vn;
+            }
+            t = fmax(t, t_out);
+            if (!(t_face <= t_vis))
+                break; /* the stretch ends inside this cell */
+            /* into the next cell, across every face the ray leaves through at t_face */
+            j += select((int3)(0), dir, te <= t_face);
+        }
+        if (!skip)
+            break;
     }
     return light_rgb(exp(-D));
 }

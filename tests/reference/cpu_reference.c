@@ -386,9 +386,14 @@ static void ray_box(const prep *P, v3 o, v3 d, float *t0, float *t1)
     float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
     float bmin[3] = {P->bmin.x, P->bmin.y, P->bmin.z}, bmax[3] = {P->bmax.x, P->bmax.y, P->bmax.z};
     /* Multiplying by the reciprocal, as the kernel does, so both round alike: a one-ulp
-     * difference in the entry point can change the number of samples on a ray. A zero
-     * component gives +-inf (or NaN on a slab plane, which fminf/fmaxf drop). */
+     * difference in the entry point can change the number of samples on a ray. A ray parallel
+     * to an axis lies in its slab (faces included) for every t or for none. */
     for (int a = 0; a < 3; ++a) {
+        if (dd[a] == 0.0f) {
+            if (!(oo[a] >= bmin[a] && oo[a] <= bmax[a]))
+                lo = INFINITY, hi = -INFINITY;
+            continue;
+        }
         float inv = 1.0f / dd[a];
         float ta = (bmin[a] - oo[a]) * inv, tb = (bmax[a] - oo[a]) * inv;
         lo = fmaxf(lo, fminf(ta, tb));
@@ -519,115 +524,201 @@ static void segment(const prep *P, float v0, float v1, float len, float out[3], 
     *spread = (hi - lo) * len;
 }
 
-/* Where the ray x(t) = xo + t xd (voxel coordinates) crosses a plane of voxel centres inside the
- * grid strictly within (ta, tb) (away from the ends by 1e-3 of the piece), the crossing nearest
- * the middle over the three axes, or -1. */
-static float kink(const prep *P, const float xo[3], const float xd[3], float ta, float tb)
+/* The interpolant along the ray over one cell's part [ta, ta + len] of it (t the ray parameter), a
+ * cubic in s = t - ta: v = c[0] + c[1] s + c[2] s^2 + c[3] s^3, fitted in double through its
+ * values at s = 0, len / 3, 2 len / 3, len (Newton's divided differences). The kernel expands the
+ * cell's trilinear blend instead; this form shares no algebra with it. */
+typedef struct cubic {
+    double ta, c[4];
+} cubic;
+
+static cubic cell_cubic(const prep *P, v3 p, v3 d, float ta, float len)
 {
-    float tm = 0.5f * (ta + tb), best = -1.0f;
-    for (int a = 0; a < 3; ++a) {
-        if (xd[a] == 0.0f)
-            continue;
-        float x0 = xo[a] + ta * xd[a], x1 = xo[a] + tb * xd[a];
-        float lo = fmaxf(fminf(x0, x1), 0.0f), hi = fminf(fmaxf(x0, x1), (float)(P->s->dims[a] - 1));
-        float c = rintf(xo[a] + tm * xd[a]);
-        c = c < ceilf(lo) ? ceilf(lo) : (c > floorf(hi) ? floorf(hi) : c);
-        if (!(c >= lo && c <= hi))
-            continue;
-        float t = (c - xo[a]) / xd[a], margin = 1e-3f * (tb - ta);
-        if (t > ta + margin && t < tb - margin && (best < 0.0f || fabsf(t - tm) < fabsf(best - tm)))
-            best = t;
+    cubic q;
+    double s[4], f[4];
+    for (int i = 0; i < 4; ++i) {
+        s[i] = len * (double)i / 3.0;
+        f[i] = sample(P, add(p, mul(d, ta + (float)s[i])));
     }
-    return best;
+    for (int j = 1; j < 4; ++j) /* divided differences, in place */
+        for (int i = 3; i >= j; --i)
+            f[i] = (f[i] - f[i - 1]) / (s[i] - s[i - j]);
+    /* f[0] + f[1] s + f[2] s (s - s1) + f[3] s (s - s1) (s - s2) */
+    q.ta = ta;
+    q.c[0] = f[0];
+    q.c[1] = f[1] - f[2] * s[1] + f[3] * s[1] * s[2];
+    q.c[2] = f[2] - f[3] * (s[1] + s[2]);
+    q.c[3] = f[3];
+    return q;
 }
 
-/* segment (len voxels, depth f, spread) refined as kernels/techniques/reference.cl does: a
- * candidate for a split at a new sample at a plane of voxel centres it crosses if the extinction
- * varies along it by more than 1e-3 of optical depth, else at its middle if by more than 4e-3;
- * the halves (their lengths dividing len at per_t voxels per unit of t) replace it, and are
- * candidates in turn (recursively, at most 3 deep) only where they differ from it by more than
- * 3e-5 in some channel; every threshold times scale, 1 over the transmittance the light keeps to
- * the segment (an error in its depth moves the shadow factor by that fraction of it). */
-static void segment_refined(const prep *P, v3 p, v3 d, const float xo[3], const float xd[3],
-                            float ta, float tb, float va, float vb, float len, float per_t,
-                            int level, const float f[3], float spread, float scale,
-                            double D[3])
+/* The piece [ta, tb] of a cell's part: the most the cubic departs from its chord there, and the
+ * integral of its departure: v - chord = (s - sa)(s - sb)(c2 + c3 (sa + sb + s)). */
+static double cubic_bend(const cubic *q, float ta, float tb)
 {
-    float tm = -1.0f;
-    if (level < 3 && spread > 1e-3f * scale) {
-        tm = kink(P, xo, xd, ta, tb);
-        if (tm < 0.0f && spread > 4e-3f * scale)
-            tm = 0.5f * (ta + tb);
-    }
-    if (tm >= 0.0f) {
-        float vm = sample(P, add(p, mul(d, tm)));
-        float len_l = clampf((tm - ta) * per_t, 0.0f, len), len_r = len - len_l;
-        float fl[3], fr[3], sl, sr, diff = 0.0f;
-        segment(P, va, vm, len_l, fl, &sl);
-        segment(P, vm, vb, len_r, fr, &sr);
+    double sa = ta - q->ta, sb = tb - q->ta, l = sb - sa;
+    return 0.25 * l * l *
+           fmax(fabs(q->c[2] + q->c[3] * (2 * sa + sb)), fabs(q->c[2] + q->c[3] * (sa + 2 * sb)));
+}
+
+static double cubic_bend_integral(const cubic *q, float ta, float tb)
+{
+    double sa = ta - q->ta, sb = tb - q->ta, l = sb - sa;
+    return -l * l * l / 6.0 * (q->c[2] + 1.5 * q->c[3] * (sa + sb));
+}
+
+/* The depth of the piece [ta, tb] of the ray p + t d within one cell (va, vb its ends' values,
+ * monotonic between), as kernels/techniques/reference.cl takes it: segment's depth, which takes
+ * the value linear, plus the extinction's secant slope between the ends times the integral of
+ * the cubic's departure from its chord (where the spread times the bend exceeds 1e-7 |vb - va|);
+ * *err: the spread times the bend over |vb - va|, what that leaves at most. */
+static void piece_curved(const prep *P, const cubic *q, float ta, float tb, float va, float vb,
+                         float per_t, double out[3], double *err)
+{
+    float f[3], spread;
+    segment(P, va, vb, (tb - ta) * per_t, f, &spread);
+    const double dv = (double)vb - va, bent = spread * cubic_bend(q, ta, tb);
+    *err = 0.0;
+    for (int ch = 0; ch < 3; ++ch)
+        out[ch] = f[ch];
+    if (bent > 1e-7 * fabs(dv)) {
+        float ca[4], cb[4], ra[3], rb[3];
+        lookup(P->light_tf, P->light_n, va, ca);
+        lookup(P->light_tf, P->light_n, vb, cb);
+        depth_rate(P, ca, ra);
+        depth_rate(P, cb, rb);
         for (int ch = 0; ch < 3; ++ch)
-            diff = fmaxf(diff, fabsf(fl[ch] + fr[ch] - f[ch]));
-        if (diff > 3e-5f * scale) {
-            segment_refined(P, p, d, xo, xd, ta, tm, va, vm, len_l, per_t, level + 1, fl, sl,
-                            scale, D);
-            segment_refined(P, p, d, xo, xd, tm, tb, vm, vb, len_r, per_t, level + 1, fr, sr,
-                            scale, D);
+            out[ch] += (rb[ch] - ra[ch]) / dv * cubic_bend_integral(q, ta, tb) * per_t;
+        *err = bent / fabs(dv);
+    }
+}
+
+/* A piece's depth (piece_curved, whole: w, err), refined as the kernel does: where err exceeds
+ * 1e-4 times scale (1 over the transmittance the light keeps to the piece) the piece is halved
+ * at its middle, and where the halves differ from the whole by more than 3e-5 times scale, each
+ * is refined in turn (at most 3 deep); else the halves are kept. Depths added to D. */
+static void piece_refined(const prep *P, v3 p, v3 d, const cubic *q, float ta, float tb,
+                          float va, float vb, float per_t, int level, float scale,
+                          const double w[3], double err, double D[3])
+{
+    if (level < 3 && err > 1e-4 * scale) {
+        float tm = 0.5f * (ta + tb), vm = sample(P, add(p, mul(d, tm)));
+        double l[3], r[3], el, er, diff = 0.0;
+        piece_curved(P, q, ta, tm, va, vm, per_t, l, &el);
+        piece_curved(P, q, tm, tb, vm, vb, per_t, r, &er);
+        for (int ch = 0; ch < 3; ++ch)
+            diff = fmax(diff, fabs(l[ch] + r[ch] - w[ch]));
+        if (diff > 3e-5 * scale) {
+            piece_refined(P, p, d, q, ta, tm, va, vm, per_t, level + 1, scale, l, el, D);
+            piece_refined(P, p, d, q, tm, tb, vm, vb, per_t, level + 1, scale, r, er, D);
             return;
         }
         for (int ch = 0; ch < 3; ++ch)
-            D[ch] += (double)fl[ch] + fr[ch];
+            D[ch] += l[ch] + r[ch];
         return;
     }
     for (int ch = 0; ch < 3; ++ch)
-        D[ch] += f[ch];
+        D[ch] += w[ch];
 }
 
-/* The exact reference's shadow ray: samples at the ends of steps of h from the point (the last
- * step partial), each segment's optical depth integrated through the transfer function, depths
- * summed in double and exponentiated once. It skips segments whose two ends lie in bricks the
- * light transfer function leaves empty, where the kernel walks their sub-cells
- * (kernels/techniques/reference.cl): both skip only segments of depth 0 (but for a visible cell
- * crossed between two samples, which neither samples), so the simpler test stays an independent
- * check of the kernel's walk. */
+/* The next parameter after t at which the ray xo + t xd (voxel coordinates, axis a) crosses a
+ * plane of voxel centres of the grid before t_end, or t_end. */
+static float next_plane(const prep *P, const float xo[3], const float xd[3], int a, float t,
+                        float t_end)
+{
+    if (xd[a] == 0.0f)
+        return t_end;
+    const int last = P->s->dims[a] - 1;
+    const float x = xo[a] + t * xd[a];
+    int k = xd[a] > 0.0f ? (int)floorf(x) + 1 : (int)ceilf(x) - 1;
+    for (;;) {
+        if (xd[a] > 0.0f ? k > last : k < 0)
+            return t_end;
+        if (xd[a] > 0.0f && k < 0)
+            k = 0;
+        if (xd[a] < 0.0f && k > last)
+            k = last;
+        float tk = ((float)k - xo[a]) / xd[a];
+        if (tk > t)
+            return fminf(tk, t_end);
+        k += xd[a] > 0.0f ? 1 : -1; /* rounding put the plane at or before t */
+    }
+}
+
+/* The exact reference's shadow ray: the path inside the box (and before a point light) cut where
+ * it crosses a plane of voxel centres (the interpolant's kinks); each cell's part cut further at
+ * the steps of h from the point and at the interpolant's extrema (the roots of its cubic's
+ * derivative), so that every piece's value is smooth and monotonic; each piece integrated by
+ * piece_refined, depths summed in double and exponentiated once. It skips a cell's part whose
+ * brick the light transfer function leaves empty, where the kernel walks the bricks' sub-cells
+ * (kernels/techniques/reference.cl): both skip only parts of depth 0, so the simpler test stays
+ * an independent check of the kernel's walk. */
 static v3 shadow(const prep *P, v3 p)
 {
     float dist;
     v3 d = to_light(P, p, &dist);
-    float ta, tb;
-    ray_box(P, p, d, &ta, &tb);
-    float t_start = fmaxf(ta, 0.0f), t_end = fminf(tb, dist);
+    float t0, t1;
+    ray_box(P, p, d, &t0, &t1);
+    const float t_start = fmaxf(t0, 0.0f), t_end = fminf(t1, dist);
     if (!(t_end > t_start))
         return mk(1, 1, 1);
-    const float h = P->shadow_step, h_vox = P->s->reference_step;
-    float len = t_end - t_start;
-    int n_full = (int)floorf(len / h);
-    float last = len - (float)n_full * h;
-    double D[3] = {0, 0, 0};
+    const float h = P->shadow_step, per_t = P->s->reference_step / h;
     const float xo[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
                          (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
                          (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
     const float xd[3] = {d.x * P->inv_spacing.x, d.y * P->inv_spacing.y, d.z * P->inv_spacing.z};
-    int skip = P->s->opts.empty_space_skipping, b[3];
-    for (int k = 0; k <= n_full; ++k) {
-        float ta_k = t_start + (float)k * h;
-        float tb_k = k < n_full ? t_start + (float)(k + 1) * h : t_end;
-        if (k == n_full && !(last > 0.0f))
-            break;
-        v3 qa = add(p, mul(d, ta_k)), qb = add(p, mul(d, tb_k));
-        if (skip && !P->light_bricks[brick_of(P, qa, b)] && !P->light_bricks[brick_of(P, qb, b)])
-            continue;
-        /* h_vox voxels a whole step, h_vox last / h the final one; its pieces divide that at
-         * h_vox / h voxels per unit of t (its t-length can round to 0, kernels/
-         * techniques/reference.cl) */
-        float va = sample(P, qa), vb = sample(P, qb), len = k < n_full ? h_vox : last * (h_vox / h);
-        float f[3], spread;
-        segment(P, va, vb, len, f, &spread);
-        /* the thresholds scaled by the transmittance the light keeps to the segment */
-        float scale = expf((float)fmin(D[0], fmin(D[1], D[2])));
-        segment_refined(P, p, d, xo, xd, ta_k, tb_k, va, vb, len, h_vox / h, 0, f, spread, scale,
-                        D);
-        if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
-            return mk(0, 0, 0);
+    const int skip = P->s->opts.empty_space_skipping;
+    double D[3] = {0, 0, 0};
+    int k = 1; /* the next step boundary, t_start + k h */
+    for (float tc = t_start; tc < t_end;) {
+        float tn = t_end;
+        for (int a = 0; a < 3; ++a)
+            tn = fminf(tn, next_plane(P, xo, xd, a, tc, t_end));
+        const float tc0 = tc;
+        tc = tn;
+        if (skip) {
+            int b[3];
+            v3 mid = add(p, mul(d, 0.5f * (tc0 + tn)));
+            if (!P->light_bricks[brick_of(P, mid, b)])
+                continue;
+        }
+        cubic q = cell_cubic(P, p, d, tc0, tn - tc0);
+        /* the extrema: roots of c1 + 2 c2 s + 3 c3 s^2 inside the part */
+        double e[2] = {INFINITY, INFINITY}, A = 3 * q.c[3], Bq = 2 * q.c[2], Cq = q.c[1];
+        if (A == 0.0) {
+            if (Bq != 0.0)
+                e[0] = -Cq / Bq;
+        } else if (Bq * Bq - 4 * A * Cq >= 0.0) {
+            double r = sqrt(Bq * Bq - 4 * A * Cq);
+            e[0] = (-Bq - r) / (2 * A);
+            e[1] = (-Bq + r) / (2 * A);
+            if (e[1] < e[0]) {
+                double x = e[0];
+                e[0] = e[1];
+                e[1] = x;
+            }
+        }
+        float ta = tc0, va = sample(P, add(p, mul(d, ta)));
+        while (ta < tn) {
+            float tk = t_start + (float)k * h;
+            while (!(tk > ta))
+                tk = t_start + (float)(++k) * h;
+            float tb = fminf(tn, tk);
+            for (int i = 0; i < 2; ++i) {
+                float te = (float)(q.ta + e[i]);
+                if (e[i] < INFINITY && te > ta && te < tb)
+                    tb = te;
+            }
+            float vb = sample(P, add(p, mul(d, tb)));
+            float scale = expf((float)fmin(D[0], fmin(D[1], D[2])));
+            double w[3], err;
+            piece_curved(P, &q, ta, tb, va, vb, per_t, w, &err);
+            piece_refined(P, p, d, &q, ta, tb, va, vb, per_t, 0, scale, w, err, D);
+            if (fmin(D[0], fmin(D[1], D[2])) > 13.815511)
+                return mk(0, 0, 0);
+            ta = tb;
+            va = vb;
+        }
     }
     return mk((float)exp(-D[0]), (float)exp(-D[1]), (float)exp(-D[2]));
 }
@@ -759,6 +850,32 @@ static view make_view(const cpu_scene *s, uint32_t w, uint32_t h)
     return v;
 }
 
+/* The light a sample of colour c at p on a view ray of direction d sends back, its shadow taken
+ * at light_at: only where there is a shadow to look up, as the kernel compiled without one
+ * does. */
+static v3 lit_sample(const prep *P, v3 p, v3 d, const float c[4], v3 light_at)
+{
+    const cpu_scene *s = P->s;
+    const umbra_render_desc *o = &s->opts;
+    v3 sf = s->shadow == UMBRA_SHADOW_REFERENCE ? shadow(P, light_at) : mk(1, 1, 1);
+    v3 light = vmul(from(s->light.color), sf);
+    v3 amb = from(o->ambient);
+    const int six = s->six_sample_shading;
+    v3 g = !o->shading ? mk(0, 0, 0) : six ? gradient_six_samples(P, p) : gradient(P, p);
+    float gl = sqrtf(dot(g, g));
+    if (!o->shading || !(gl > 1e-6f))
+        return vmul(mk(c[0], c[1], c[2]), add(amb, light));
+    v3 nrm = mul(g, -1.0f / gl);
+    float dist;
+    v3 l = to_light(P, p, &dist);
+    v3 hv = norm(add(l, mul(d, -1.0f)));
+    float diff = fabsf(dot(nrm, l));
+    float spec = six ? powf(fabsf(dot(nrm, hv)), o->shininess)
+                     : shading_power(fabsf(dot(nrm, hv)), o->shininess);
+    return add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
+               mul(light, o->ks * spec));
+}
+
 static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int px, int py,
                       float out[4])
 {
@@ -796,7 +913,34 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             walk w;
             walk_begin(P, &w, org, d, t0);
             float t_cell = -INFINITY; /* samples before it lie in a visible cell */
-            for (int k = 0; k < n;) {
+            int k = 0;
+            /* A jittered ray (kernels/raycast.cl): the unjittered first sample at t0, then the
+             * unjittered second, at t0 + h, cut to the fraction jitter of a step (its light at
+             * the fraction's mean emission depth from where that sample's segment begins), then
+             * the jittered samples from k = 1. */
+            if (jitter > 0.0f) {
+                for (int pre = 0; pre < 2 && A <= o->termination; ++pre) {
+                    float tp = t0 + (float)pre * hstep;
+                    if (!(tp < t1))
+                        break;
+                    v3 p = add(org, mul(d, tp));
+                    ++taken;
+                    lookup(P->view_tf, P->view_n, sample(P, p), c);
+                    float a = pre ? (c[3] < 1.0f ? -expm1f(jitter * log1pf(-c[3])) : 1.0f) : c[3];
+                    if (!(a > 0.0f))
+                        continue;
+                    float m = cpu_emission_depth(a);
+                    v3 at = pre ? add(p, mul(d, -0.5f * hstep * (1.0f + c[3]) + jitter * hstep * m))
+                                : add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep));
+                    v3 lit = lit_sample(P, p, d, c, at);
+                    col[0] += (1.0f - A) * a * lit.x;
+                    col[1] += (1.0f - A) * a * lit.y;
+                    col[2] += (1.0f - A) * a * lit.z;
+                    A += (1.0f - A) * a;
+                }
+                k = A > o->termination ? n : 1;
+            }
+            while (k < n) {
                 float t = t0 + ((float)k + jitter) * hstep;
                 if (o->empty_space_skipping && t >= t_cell) {
                     float t_in = walk_to_visible(P, &w, t, t1);
@@ -817,32 +961,10 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 lookup(P->view_tf, P->view_n, sample(P, p), c);
                 if (c[3] > 0.0f) {
                     /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
-                     * a segment of opacity a (kernels/raycast.cl, shadow_point); only where
-                     * there is a shadow to look up, as the kernel compiled without one does. */
-                    v3 sf = mk(1, 1, 1);
-                    if (P->s->shadow == UMBRA_SHADOW_REFERENCE) {
-                        float a = c[3], m = cpu_emission_depth(a);
-                        sf = shadow(P, add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep)));
-                    }
-                    v3 light = vmul(from(s->light.color), sf);
-                    v3 amb = from(o->ambient);
-                    v3 lit;
-                    const int six = P->s->six_sample_shading;
-                    v3 g = !o->shading ? mk(0, 0, 0) : six ? gradient_six_samples(P, p) : gradient(P, p);
-                    float gl = sqrtf(dot(g, g));
-                    if (!o->shading || !(gl > 1e-6f)) {
-                        lit = vmul(mk(c[0], c[1], c[2]), add(amb, light));
-                    } else {
-                        v3 nrm = mul(g, -1.0f / gl);
-                        float dist;
-                        v3 l = to_light(P, p, &dist);
-                        v3 hv = norm(add(l, mul(d, -1.0f)));
-                        float diff = fabsf(dot(nrm, l));
-                        float spec = six ? powf(fabsf(dot(nrm, hv)), o->shininess)
-                                         : shading_power(fabsf(dot(nrm, hv)), o->shininess);
-                        lit = add(vmul(mk(c[0], c[1], c[2]), add(amb, mul(light, o->kd * diff))),
-                                  mul(light, o->ks * spec));
-                    }
+                     * a segment of opacity a (kernels/raycast.cl, shadow_point). */
+                    float a = c[3], m = cpu_emission_depth(a);
+                    v3 at = add(p, mul(d, (m - 0.5f * (1.0f + a)) * hstep));
+                    v3 lit = lit_sample(P, p, d, c, at);
                     col[0] += (1.0f - A) * c[3] * lit.x;
                     col[1] += (1.0f - A) * c[3] * lit.y;
                     col[2] += (1.0f - A) * c[3] * lit.z;
