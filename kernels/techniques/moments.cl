@@ -67,7 +67,7 @@ typedef struct ShadowRay {
 
 inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
-/* Channel c (a constant in the unrolled loops) of a light_t. */
+/* Channel c of a light_t. */
 #if UMBRA_LIGHT_CHANNELS == 1
 #define MOM_CH(v, c) (v)
 #else
@@ -312,7 +312,7 @@ UMBRA_INLINE float mom_kernel_diag(float L[MOM_N_MAX + 1][MOM_N_MAX + 1], const 
 
 /* Roots of sum c[i] x^i, i = 0..deg (1 <= deg <= 4, all roots real: a kernel polynomial's),
  * into r; returns 0 when the leading coefficient vanishes (no root is then trusted), else deg.
- * deg is a constant at every call, so only its branch is compiled. */
+ * deg is the Hankel order, read at run time (count / 2). */
 UMBRA_INLINE int mom_roots(const float *c_in, const int deg, float *r)
 {
     float c[MOM_N_MAX + 1];
@@ -446,7 +446,7 @@ UMBRA_INLINE int mom_bounds_of_order(const float *m, const int n, float x0, floa
     return 1;
 }
 
-/* mom_bounds_of_order at order n (a constant), else at the highest lower order that is well
+/* mom_bounds_of_order at order n, else at the highest lower order that is well
  * posed (rare: the bias keeps order n so), else a single point at the mean. */
 UMBRA_INLINE void mom_bounds(const float *m, const int n, float x0, float *lower, float *w0)
 {
@@ -480,9 +480,11 @@ UMBRA_INLINE float mom_depth(__global const UmbraMoments *P, const int count, fl
     return b0 * clamp(f, 0.0f, 1.0f);
 }
 
-/* The shadow factor at p for a count and storage known at compile time (moments_lookup below
- * picks one, so that the loops unroll and the arrays stay in registers): the bilinear mix of
- * the four texels around p's map position. */
+/* The shadow factor at p: the bilinear mix of the four texels around p's map position.
+ * Specialising it per count and storage at compile time (a switch over six instances with
+ * constant count and bits) measured no faster on PoCL and compiled six copies, so count and
+ * bits are read at run time; the cost is the reconstruction's arithmetic, per channel and sample
+ * (docs/moments.md has the measurements). */
 UMBRA_INLINE float3 moments_lookup_as(__global const UmbraShadow *S,
                                       __global const UmbraMoments *P, __global const uint *map,
                                       float3 p, const int count, const uint bits)
@@ -530,15 +532,7 @@ UMBRA_INLINE float3 moments_lookup_as(__global const UmbraShadow *S,
 UMBRA_INLINE float3 moments_lookup(__global const UmbraShadow *S, __global const UmbraMoments *P,
                                    __global const uint *map, float3 p)
 {
-    const uint key = P->count * 64u + P->bits;
-    switch (key) {
-    case 4u * 64u + 16u: return moments_lookup_as(S, P, map, p, 4, 16u);
-    case 6u * 64u + 16u: return moments_lookup_as(S, P, map, p, 6, 16u);
-    case 8u * 64u + 16u: return moments_lookup_as(S, P, map, p, 8, 16u);
-    case 4u * 64u + 32u: return moments_lookup_as(S, P, map, p, 4, 32u);
-    case 8u * 64u + 32u: return moments_lookup_as(S, P, map, p, 8, 32u);
-    default: return moments_lookup_as(S, P, map, p, 6, 32u);
-    }
+    return moments_lookup_as(S, P, map, p, (int)P->count, P->bits);
 }
 
 #define SHADOW_FACTOR(sr, p) moments_lookup(S, P, shadow_map, (p))
