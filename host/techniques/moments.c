@@ -27,7 +27,7 @@ static uint32_t values(umbra_renderer r)
 }
 
 /* The moment bias when the desc leaves it at 0: the smallest that kept the reconstruction
- * well posed for each count and storage (docs/techniques/moments.md). */
+ * well posed for each count and storage (docs/moments.md). */
 static float own_bias(const umbra_moments_desc *d)
 {
     const int i = d->count == 4u ? 0 : d->count == 6u ? 1 : 2;
@@ -106,25 +106,22 @@ static const umbra__param params[] = {
                        .min = 0, .max = UMBRA_MOMENTS_MAX_BLUR),
 };
 
-/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting). */
+/* What `umbra-bench accuracy` sweeps (host/renderer_internal.h, umbra__setting): sizes chosen
+ * for equal memory with the other maps' 512^2 rows (docs/moments.md): 296^2 at 4 moments and
+ * 16 bits (12 bytes per texel and channel) holds what CSSM's 512^2 holds (4); 512^2 at 6 moments
+ * and 16 bits (16 bytes per texel and channel) what the deep map's 512^2 with 3 nodes holds in
+ * colour (a node of a depth and three channels is 16 bytes: 48 bytes per texel). */
+#define Q (UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL)
 static const umbra__setting sweep[] = {
     {"", "moments", UMBRA__SWEEP_BUILDS},
-    {"moments=4", "m4", UMBRA__SWEEP_QUICK},
-    {"moments=6", "m6", UMBRA__SWEEP_QUICK},
-    {"moments=8", "m8", UMBRA__SWEEP_QUICK},
-    {"moments=4;moment_bits=16", "m4 16b", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_bits=16", "m6 16b", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_overestimation=0", "m6 b0", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_overestimation=0.25", "m6 b.25", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_overestimation=0.75", "m6 b.75", UMBRA__SWEEP_QUICK},
-    {"moments=4;moment_overestimation=0.25", "m4 b.25", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_blur=1", "m6 blur1", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_blur=2", "m6 blur2", UMBRA__SWEEP_QUICK},
-    {"moments=6;map_texels_per_voxel=2", "m6 tpv2", UMBRA__SWEEP_QUICK},
-    {"moments=6;map_step=0.5", "m6 step.5", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_bias=1e-4", "m6 bias1e-4", UMBRA__SWEEP_QUICK},
-    {"moments=6;moment_bias=1e-6", "m6 bias1e-6", UMBRA__SWEEP_QUICK},
+    {"map_size=296;moments=4;moment_bits=16", "296², 4 moments, 16 bits", Q},
+    {"map_size=512;moments=6;moment_bits=16", "512², 6 moments, 16 bits", Q},
+    {"map_size=256;moments=6", "256², 6 moments", Q},
+    {"map_size=512;moments=6", "512², 6 moments", Q},
+    {"map_size=256;moments=8", "256², 8 moments", Q},
+    {"map_size=512;moments=6;moment_overestimation=0", "512², 6 moments, β 0", Q},
 };
+#undef Q
 
 static const char *const kernel_files[] = {"techniques/moments_shared.h",
                                            "techniques/moments.cl", NULL};

@@ -5,7 +5,7 @@
  * its light ray and a few power moments of how that depth is spread over the ray, from which the
  * lookup bounds the optical depth in front of a sample (the Hausdorff bounds) and takes a point
  * between the bounds. Fixed memory: map_size^2 x channels x (1 + moments) x 4 bytes at 32 bits,
- * (1 + moments / 2) x 4 at 16 (docs/techniques/moments.md). */
+ * (1 + moments / 2) x 4 at 16 (docs/moments.md). */
 #ifndef UMBRA_TECHNIQUES_MOMENTS_H
 #define UMBRA_TECHNIQUES_MOMENTS_H
 
