@@ -137,7 +137,7 @@ const umbra__technique umbra__technique_moments = {
                "and takes a point between the bounds. Smooth, coloured, linearly filterable "
                "shadows in a fixed 4 (1 + moments) bytes per texel and channel; the bounds "
                "widen inside thick, varied material.",
-        .flags = UMBRA_TECHNIQUE_MAP,
+        .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         .map_texels_per_voxel = 1.0f,

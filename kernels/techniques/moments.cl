@@ -184,7 +184,7 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
                 break;
             const float t_start = tb.x + (float)k * h;
             const float4 col =
-                tf_lookup(light_tf, n_tf, sample_volume(vol, g, o + (t_start + 0.5f * seg) * d));
+                light_sample(F, vol, g, light_tf, n_tf, o + (t_start + 0.5f * seg) * d);
             if (col.w > 0.0f) {
                 const light_t od = light_depth(col, h_vox * (seg / h), flags);
                 const float xa = 2.0f * ls_depth(S, o, t_start) - 1.0f;
