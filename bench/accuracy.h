@@ -73,7 +73,8 @@ typedef struct result {
     uint64_t samples;
     metrics_error err;
     uint32_t width, height;
-    int pareto_time, pareto_memory;
+    int pareto_time, pareto_memory, pareto_texel; /* on the front of time, memory, bytes per
+                                                     map texel */
     /* The yardstick's own error: the scene's reference at its step against the reference at half
      * that step (display values, as err); rmse < 0 when it could not be measured. */
     metrics_error ref_unc;
@@ -158,6 +159,12 @@ void accuracy_run_scene(bench_run *B, int si);
 
 /* Marks the per-scene Pareto fronts in B->results and writes them under <out>/plots. */
 void accuracy_pareto(bench_run *B);
+/* A light-space map's shadow memory over its texels (map_size^2): bytes per texel; 0 for a run
+ * without a map. */
+static inline double accuracy_bytes_per_texel(const result *r)
+{
+    return r->map_size ? (double)r->memory / ((double)r->map_size * (double)r->map_size) : 0.0;
+}
 
 /* <out>/accuracy.csv, one row per result; a file that cannot be written is a failure. */
 void accuracy_write_csv(bench_run *B);

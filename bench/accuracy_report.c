@@ -29,23 +29,26 @@ static int cmp_front(const void *a, const void *b)
     return (x->rmse > y->rmse) - (x->rmse < y->rmse);
 }
 
-/* Marks, per scene, the runs no other run beats in both cost and error (strictly in one). The
- * exact reference (error 0 by definition) and, for memory, runs that hold no memory are left out:
- * the plots are logarithmic. Writes the fronts, sorted by cost, to <out>/plots/<scene>-pareto-
- * {time,memory}.dat for gnuplot. */
+/* Marks, per scene, the runs no other run beats in both cost and error (strictly in one), for
+ * three costs: time, memory and, over the light-space maps only, bytes per map texel (memory /
+ * map_size^2). The exact reference (error 0 by definition) and, for memory, runs that hold no
+ * memory are left out: the plots are logarithmic. Writes the fronts, sorted by cost, to
+ * <out>/plots/<scene>-pareto-{time,memory,texel}.dat for gnuplot. */
 void accuracy_pareto(bench_run *B)
 {
     front_point *pts = malloc((size_t)(B->result_count + 1) * sizeof *pts);
     if (!pts)
         return;
     for (int si = 0; si < B->scene_count; ++si)
-        for (int mem = 0; mem < 2; ++mem) {
+        for (int mem = 0; mem < 3; ++mem) { /* 0 time, 1 memory, 2 bytes per map texel */
             int n = 0;
             for (int k = 0; k < B->result_count; ++k) {
                 const result *r = &B->results[k];
                 if (r->scene == si && !r->cfg.exact && r->err.rmse > 0.0 &&
-                    (!mem || r->memory > 0)) {
-                    pts[n].cost = mem ? (double)r->memory : r->total_ms;
+                    (!mem || r->memory > 0) && (mem < 2 || r->map_size > 0)) {
+                    pts[n].cost = mem == 2   ? accuracy_bytes_per_texel(r)
+                                  : mem == 1 ? (double)r->memory
+                                             : r->total_ms;
                     pts[n].rmse = r->err.rmse;
                     pts[n].row = k;
                     ++n;
@@ -55,17 +58,21 @@ void accuracy_pareto(bench_run *B)
                 continue;
             qsort(pts, (size_t)n, sizeof *pts, cmp_front);
             char path[4200];
+            static const char *const kind[3] = {"time", "memory", "texel"};
+            static const char *const unit[3] = {"total_ms", "memory_mib", "bytes_per_texel"};
             snprintf(path, sizeof path, "%s/plots/%s-pareto-%s.dat", B->o.out,
-                     B->scenes[si].name, mem ? "memory" : "time");
+                     B->scenes[si].name, kind[mem]);
             FILE *f = fopen(path, "w");
             if (f)
-                fprintf(f, "# %s,rmse,technique and setting\n", mem ? "memory_mib" : "total_ms");
+                fprintf(f, "# %s,rmse,technique and setting\n", unit[mem]);
             double best = INFINITY;
             for (int j = 0; j < n; ++j) {
                 result *r = &B->results[pts[j].row];
                 if (r->err.rmse < best) {
                     best = r->err.rmse;
-                    if (mem)
+                    if (mem == 2)
+                        r->pareto_texel = 1;
+                    else if (mem)
                         r->pareto_memory = 1;
                     else
                         r->pareto_time = 1;
@@ -75,7 +82,10 @@ void accuracy_pareto(bench_run *B)
                     accuracy_sanitize(label, 0);
                     if (f)
                         fprintf(f, "%.6g,%.6g,%s\n",
-                                mem ? (double)r->memory / 1048576.0 : r->total_ms, r->err.rmse,
+                                mem == 2 ? pts[j].cost
+                                : mem    ? (double)r->memory / 1048576.0
+                                         : r->total_ms,
+                                r->err.rmse,
                                 label);
                 }
             }
@@ -94,7 +104,7 @@ static const char *const csv_columns[] = {
     "render_overhead", "build_over_frame", "reference_ms", "speedup_vs_reference", "memory_bytes",
     "light_channels", "slices", "samples", "rmse", "psnr_db", "max_abs", "mean_abs", "ssim",
     "pareto_time", "pareto_memory", "reference_half_step_rmse", "reference_half_step_max_abs",
-    "map_size",
+    "map_size", "bytes_per_texel", "pareto_texel",
 };
 
 static int csv_column(const char *name)
@@ -158,7 +168,11 @@ void accuracy_write_csv(bench_run *B)
             fprintf(f, "%.6g,%.6g,", r->ref_unc.rmse, r->ref_unc.max_abs);
         else
             fprintf(f, ",,");
-        fprintf(f, "%u\n", r->map_size);
+        fprintf(f, "%u,", r->map_size);
+        if (r->map_size > 0 && r->memory > 0)
+            fprintf(f, "%.6g,%d\n", accuracy_bytes_per_texel(r), r->pareto_texel);
+        else
+            fprintf(f, ",\n");
     }
     fclose(f);
 }
@@ -189,17 +203,19 @@ void accuracy_write_plots(bench_run *B)
         /* Techniques present in this scene, with a fixed style index each across all plots;
          * for the memory plot only those that hold memory (the axis is logarithmic). */
         char techs[256] = "", styles[64] = "", techs_mem[256] = "", styles_mem[64] = "";
-        int any = 0, any_mem = 0;
+        char techs_map[256] = "", styles_map[64] = "";
+        int any = 0, any_mem = 0, any_map = 0;
         /* The registry's order gives each technique its style (bench/plot_accuracy.gp). */
         for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
             const umbra_technique_info *ti = umbra_technique_get(t);
-            int has = 0, has_mem = 0;
+            int has = 0, has_mem = 0, has_map = 0;
             for (int k = 0; k < B->result_count; ++k) {
                 const result *r = &B->results[k];
                 if (r->scene == si && r->cfg.desc.technique == ti->id && !r->cfg.exact &&
                     r->err.rmse > 0.0) {
                     has = 1;
                     has_mem |= r->memory > 0;
+                    has_map |= r->memory > 0 && r->map_size > 0;
                 }
             }
             const char *name = ti->name;
@@ -214,6 +230,12 @@ void accuracy_write_plots(bench_run *B)
                 snprintf(techs_mem + n, sizeof techs_mem - n, "%s%s", any_mem ? " " : "", name);
                 snprintf(styles_mem + m, sizeof styles_mem - m, "%s%u", any_mem ? " " : "", t + 1);
                 any_mem = 1;
+            }
+            if (has_map) {
+                size_t n = strlen(techs_map), m = strlen(styles_map);
+                snprintf(techs_map + n, sizeof techs_map - n, "%s%s", any_map ? " " : "", name);
+                snprintf(styles_map + m, sizeof styles_map - m, "%s%u", any_map ? " " : "", t + 1);
+                any_map = 1;
             }
         }
         if (!any)
@@ -241,11 +263,18 @@ void accuracy_write_plots(bench_run *B)
         gp_string(gp, "out_time", buf);
         snprintf(buf, sizeof buf, "%s/plots/%s-error-vs-memory.png", B->o.out, spec->name);
         gp_string(gp, "out_memory", any_mem ? buf : "");
+        snprintf(buf, sizeof buf, "%s/plots/%s-pareto-texel.dat", B->o.out, spec->name);
+        gp_string(gp, "pareto_texel", buf);
+        snprintf(buf, sizeof buf, "%s/plots/%s-error-vs-bytes-per-texel.png", B->o.out,
+                 spec->name);
+        gp_string(gp, "out_texel", any_map ? buf : "");
+        gp_string(gp, "techniques_texel", techs_map);
+        gp_string(gp, "styles_texel", styles_map);
         fprintf(gp, "c_scene = %d\nc_tech = %d\nc_total = %d\nc_rmse = %d\nc_mem = %d\n"
-                    "c_exact_ref = %d\nc_width = %d\nc_height = %d\n",
+                    "c_exact_ref = %d\nc_width = %d\nc_height = %d\nc_bpt = %d\n",
                 csv_column("scene"), csv_column("technique"), csv_column("total_ms"),
                 csv_column("rmse"), csv_column("memory_bytes"), csv_column("reference_ms"),
-                csv_column("width"), csv_column("height"));
+                csv_column("width"), csv_column("height"), csv_column("bytes_per_texel"));
         gp_string(gp, "script", script);
         fprintf(gp, "load script\n");
         int rc = pclose(gp);

@@ -18,6 +18,9 @@
 #   pareto_*       the Pareto fronts the bench computed, "cost,rmse,label" sorted by cost
 #   out_time       PNG: RMSE against build + render time
 #   out_memory     PNG: RMSE against shadow memory ("" for none: no technique holds memory)
+#   techniques_texel, styles_texel, pareto_texel, c_bpt   the light-space maps, their front and
+#                  the CSV's bytes_per_texel column, for
+#   out_texel      PNG: RMSE against bytes per map texel ("" for none: no map in the scene)
 
 if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {
     set terminal pngcairo size 1000,660 noenhanced font 'sans,10'
@@ -61,5 +64,17 @@ if (strlen(out_memory) > 0) {
             title word(techniques_memory, i), \
          pareto_memory using 1:2 with steps lw 1.5 dt 2 lc rgb '#444444' title 'Pareto front', \
          pareto_memory using 1:2:3 with labels left offset 0.8,0.6 font ',7' tc rgb '#444444' notitle
+}
+
+if (exists("out_texel") && strlen(out_texel) > 0) {
+    set output out_texel
+    set title sprintf("%s\nimage error against the exact reference vs. bytes per light-space map texel", scene_title)
+    set xlabel 'shadow memory per map texel (bytes, log scale)'
+    plot for [i=1:words(techniques_texel)] csv skip 1 \
+            using (sel(word(techniques_texel, i)) && column(c_rmse) > 0 && column(c_bpt) > 0 ? column(c_bpt) : NaN):(column(c_rmse)) \
+            with points pt pt_of(word(styles_texel, i) + 0) ps 1.6 lc rgb lc_of(word(styles_texel, i) + 0) \
+            title word(techniques_texel, i), \
+         pareto_texel using 1:2 with steps lw 1.5 dt 2 lc rgb '#444444' title 'Pareto front', \
+         pareto_texel using 1:2:3 with labels left offset 0.8,0.6 font ',7' tc rgb '#444444' notitle
 }
 set output

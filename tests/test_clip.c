@@ -243,7 +243,11 @@ static void test_clipped_occluder_casts_no_shadow(void **state)
                 print_message("%s rotated %d crop %d: gap lit >= %.4f clipped, <= %.3f "
                               "unclipped; receiver vs zeroed max %.3g mean %.3g\n", ti->name,
                               rotated, crop, lit, dark, d, mean);
-                assert_true(lit >= 0.999f);
+                /* A moment map's estimate lies between bounds on the depth in front (its
+                 * overestimation leaks a little shadow from the receiver behind the gap:
+                 * measured 0.985, docs/moments.md); the others light the gap exactly. */
+                const int moments = umbra_technique_param_find(ti, "moment_overestimation") != NULL;
+                assert_true(lit >= (moments ? 0.98f : 0.999f));
                 assert_true(dark <= 0.2f);
                 /* A stochastic map (one with a seed: CSSM) stops its photons in other segments
                  * when they start at another face: noise of its own size. */

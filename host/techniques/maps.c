@@ -13,7 +13,7 @@ typedef struct map_state {
     cl_mem map;
     size_t map_bytes;
     cl_program program; /* owned by the context's cache; the program build_kernel came from */
-    cl_kernel build_kernel;
+    cl_kernel build_kernel, filter_kernel;
     unsigned char constants[64]; /* the technique's kernel constants (kind->constants_size) */
     int built;
     cl_mem constants_buf;
@@ -27,6 +27,45 @@ static map_state *state_get(umbra_renderer r)
 }
 
 const double umbra__map_taps[4] = {1, 7, 13, 21};
+
+/* The map kind's filter passes over the built map (maps.h): each reads the map and writes a new
+ * buffer, which becomes the map; the buffer read is released after the pass. */
+static umbra_status run_filter(umbra_renderer r, map_state *s, uint32_t passes, double *ms)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const cl_uint n = r->shadow_params.map_size;
+    cl_mem out = NULL;
+    for (cl_uint pass = 0; pass < passes; ++pass) {
+        cl_int err;
+        out = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_WRITE, s->map_bytes, NULL, &err);
+        if (err != CL_SUCCESS) {
+            int oom = err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE;
+            return umbra__fail(ctx, oom ? UMBRA_ERROR_OUT_OF_MEMORY : UMBRA_ERROR_OPENCL,
+                               "umbra_renderer_render: %s map filter pass of %u x %u texels "
+                               "(%zu bytes): clCreateBuffer failed with %s (%d)",
+                               r->tech->info.name, n, n, s->map_bytes,
+                               umbra__cl_error_name(err), (int)err);
+        }
+        UMBRA_CL(clSetKernelArg(s->filter_kernel, 0, sizeof(cl_mem), &r->shadow_buf));
+        UMBRA_CL(clSetKernelArg(s->filter_kernel, 1, sizeof(cl_mem), &s->constants_buf));
+        UMBRA_CL(clSetKernelArg(s->filter_kernel, 2, sizeof pass, &pass));
+        UMBRA_CL(clSetKernelArg(s->filter_kernel, 3, sizeof(cl_mem), &s->map));
+        UMBRA_CL(clSetKernelArg(s->filter_kernel, 4, sizeof(cl_mem), &out));
+        const size_t global[2] = {n, n};
+        /* cost: a pass reads a few texels per work-item, nothing like a light ray */
+        if ((st = umbra__run_2d(r, s->filter_kernel, global, NULL, 16.0, ms,
+                                "umbra_renderer_render")) != UMBRA_SUCCESS)
+            goto fail;
+        clReleaseMemObject(s->map);
+        s->map = out;
+        out = NULL;
+    }
+fail:
+    if (out)
+        clReleaseMemObject(out);
+    return st;
+}
 
 umbra_status umbra__map_build(umbra_renderer r, double *ms)
 {
@@ -61,9 +100,13 @@ umbra_status umbra__map_build(umbra_renderer r, double *ms)
     if (program != s->program || !s->build_kernel) {
         if (s->build_kernel)
             clReleaseKernel(s->build_kernel);
-        s->build_kernel = NULL;
+        if (s->filter_kernel)
+            clReleaseKernel(s->filter_kernel);
+        s->build_kernel = s->filter_kernel = NULL;
         s->program = NULL;
-        if ((st = umbra__kernel_create(ctx, program, kind->build_kernel, &s->build_kernel)))
+        if ((st = umbra__kernel_create(ctx, program, kind->build_kernel, &s->build_kernel)) ||
+            (kind->filter_kernel &&
+             (st = umbra__kernel_create(ctx, program, kind->filter_kernel, &s->filter_kernel))))
             return st;
         s->program = program;
     }
@@ -97,6 +140,10 @@ umbra_status umbra__map_build(umbra_renderer r, double *ms)
     size_t global[2] = {blocks, blocks};
     st = umbra__run_2d(r, s->build_kernel, global, NULL,
                        umbra__ray_samples(r, r->tech->light_step(d)), ms, "umbra_renderer_render");
+    const uint32_t passes =
+        kind->filter_kernel && kind->filter_passes ? kind->filter_passes(r) : 0u;
+    if (st == UMBRA_SUCCESS && passes)
+        st = run_filter(r, s, passes, ms);
 fail:
     return st;
 }
@@ -134,6 +181,8 @@ void umbra__map_destroy(umbra_renderer r)
         return;
     if (s->build_kernel)
         clReleaseKernel(s->build_kernel);
+    if (s->filter_kernel)
+        clReleaseKernel(s->filter_kernel);
     if (s->map)
         clReleaseMemObject(s->map);
     if (s->constants_buf)
@@ -146,4 +195,19 @@ const void *umbra__map_constants(umbra_renderer r)
 {
     const map_state *s = r->tech_state;
     return s && s->built ? s->constants : NULL;
+}
+
+umbra_status umbra__map_read(umbra_renderer r, void *out, size_t bytes)
+{
+    const map_state *s = r->tech->build == umbra__map_build ? r->tech_state : NULL;
+    umbra_status st = UMBRA_SUCCESS;
+    umbra_context ctx = r->ctx;
+    if (!s || !s->map || !s->built || bytes < s->map_bytes)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra__map_read: %zu bytes for a map of %zu (built: %d)", bytes,
+                           s ? s->map_bytes : (size_t)0, s ? s->built : 0);
+    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, s->map, CL_TRUE, 0, s->map_bytes, out, 0, NULL,
+                                 NULL));
+fail:
+    return st;
 }

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/techniques/maps.h: what a single-layer light-space map shares (the threshold map and CSSM
- * use it; a map of a fixed number of floats per texel can): a map buffer fitted to the volume's
- * box (host/lightspace.c) that lives as long as the technique and is re-allocated only when its
- * size changes, the build kernel from the technique's own kernel files, and the technique's
- * kernel constants passed to the build and to every lookup. The renderer calls the build only
+ * use it; a map of a fixed number of floats per texel can): a map buffer
+ * fitted to the volume's box (host/lightspace.c) that lives as long as the technique and is
+ * re-allocated only when its size changes, the build kernel from the technique's own kernel
+ * files (and, optionally, filter passes over the built map), and the technique's kernel
+ * constants passed to the build and to every lookup. The renderer calls the build only
  * when the light, volume, light transfer function or a parameter that rebuilds changed, so a
  * camera move re-uses the map. */
 #ifndef UMBRA_TECHNIQUES_MAPS_H
@@ -25,6 +26,14 @@ typedef struct umbra__map_kind {
     /* Refreshes, before every lookup, the constants the lookup reads that do not rebuild the
      * map (optional). */
     void (*lookup_constants)(umbra_renderer r, void *constants);
+    /* A linear filter over the built map (optional): filter_kernel, in the technique's kernel
+     * files, runs filter_passes(r) times after the build kernel (0: not at all), one work-item
+     * per texel, with the arguments (shadow parameters, constants, pass index as a uint, the map
+     * read, the map written); each pass writes a fresh buffer of the map's size, which becomes
+     * the map, so a separable filter is one pass per axis. The buffer a pass read is freed when
+     * the build ends: between builds the technique holds only the map. */
+    const char *filter_kernel;
+    uint32_t (*filter_passes)(umbra_renderer r);
 } umbra__map_kind;
 
 /* The technique functions of a single-layer map, whose descriptor's data is its umbra__map_kind:
@@ -41,5 +50,10 @@ extern const double umbra__map_taps[4];
 /* The kernel constants the last build or lookup used (tests read them): constants_size bytes,
  * or NULL before the first build. */
 const void *umbra__map_constants(umbra_renderer r);
+
+/* Copies the built map (tests read it) into out, which holds `bytes`: at least the map's size
+ * (umbra_render_stats.shadow_memory_bytes). UMBRA_ERROR_INVALID_ARGUMENT before a build or for
+ * a smaller out. */
+umbra_status umbra__map_read(umbra_renderer r, void *out, size_t bytes);
 
 #endif

@@ -23,6 +23,7 @@
 #include "umbra/techniques/convolution.h"
 #include "umbra/techniques/cssm.h"
 #include "umbra/techniques/deep.h"
+#include "umbra/techniques/moments.h"
 #include "umbra/techniques/reference.h"
 #include "umbra/techniques/threshold.h"
 
@@ -32,6 +33,7 @@
     X(threshold, THRESHOLD, 2, umbra_threshold_desc threshold;)                                \
     X(cssm, CSSM, 4, umbra_cssm_desc cssm;)                                                    \
     X(deep, DEEP, 3, umbra_deep_desc deep;)                                                    \
-    X(convolution, CONVOLUTION, 5, umbra_convolution_desc convolution;)
+    X(convolution, CONVOLUTION, 5, umbra_convolution_desc convolution;)                        \
+    X(moments, MOMENTS, 6, umbra_moments_desc moments;)
 
 #endif
