@@ -180,7 +180,7 @@ static const fixed_option fixed[] = {
     {"raw-dims", OPT_RAW_DIMS, "XxYxZ", "the raw file's voxels per axis"},
     {"raw-type", OPT_RAW_TYPE, "T", "the raw file's voxel type: uint8, uint16, int16 or float32"},
     {"raw-big-endian", OPT_RAW_BIG_ENDIAN, NULL, "the raw file is big-endian"},
-    {"tf", OPT_TF, "FILE", "transfer function: text format (see README) or a ParaView preset "
+    {"tf", OPT_TF, "FILE", "transfer function: text format (docs/usage.md) or a ParaView preset "
                            ".json (x in the volume's data units)"},
     {"tf-preset", OPT_TF_PRESET, "NAME", "the preset to pick from a .json holding several"},
     {"light-tf", OPT_LIGHT_TF, "FILE", "separate transfer function for the light pass"},
@@ -747,7 +747,7 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
                 givens[ngiven++] = (given){"seed", "seed", v, 0.0};
             break;
         case OPT_DEVICE: {
-            /* P:D (platform and device indices) as the README documents, else a name substring. */
+            /* P:D (platform and device indices) as docs/usage.md has it, else a name substring. */
             uint32_t pd[2];
             if (parse_u32_list(v, ':', 2, 0, 1023, pd)) {
                 o->platform_index = (int)pd[0];

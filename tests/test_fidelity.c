@@ -24,7 +24,7 @@
  *    spacing, coloured, directional and point light): FID_RANDOM_BOUND, and the mean error;
  *  - and, rendered: an alpha = 1 sphere's lit face equals the unshadowed image to 0.02, with and
  *    without jitter (no speckles).
- * Each bound is also stated in the README ("Hard cases"). */
+ * Each bound is also stated in docs/techniques.md ("Hard cases"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
