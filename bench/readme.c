@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 /* bench/readme.c: `umbra-bench readme`, which writes the measured sections of the README and of
- * the docs it manages (README.md, docs/accuracy.md) from the recorded results, so that no figure
- * there is typed by hand.
+ * the docs it manages from the recorded results, so that no figure there is typed by hand.
  *
- * Each managed file marks each generated block with a pair of HTML comments:
+ * The files managed: README.md and docs/accuracy.md, which must hold blocks, and any other
+ * .md file in docs/ that holds one (in name order). Each marks each generated block with a pair of HTML
+ * comments:
  *
  *     <!-- umbra-bench readme: NAME -->
  *     ... replaced on every run ...
@@ -22,6 +23,7 @@
  * file is out of date (for a pre-commit check and the docs_check test). */
 #define _XOPEN_SOURCE 700
 
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -384,10 +386,10 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
                "[--check]\n"
-               "  rewrites the '" MARK_BEGIN "choose|headline|gallery -->' blocks of README.md\n"
-               "  and docs/accuracy.md from the results of `umbra-bench accuracy`\n"
-               "  --readme FILE   only this file (default: <source>/README.md and\n"
-               "                  <source>/docs/accuracy.md)\n"
+               "  rewrites the '" MARK_BEGIN "choose|headline|gallery -->' blocks of README.md,\n"
+               "  docs/accuracy.md and any other docs/*.md holding one, from the results of\n"
+               "  `umbra-bench accuracy`\n"
+               "  --readme FILE   only this file\n"
                "  --results DIR   default <source>/bench/results/accuracy\n"
                "  --scene NAME    the scene of the plots and pictures (default walnut)\n"
                "  --check         change nothing; exit 1 if a file is out of date\n");
@@ -427,13 +429,56 @@ static int process_file(job *J, int check)
     return rc;
 }
 
+#define MAX_FILES 64
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp((const char *)a, (const char *)b);
+}
+
+/* The files to manage: README.md, docs/accuracy.md, then every other .md file in docs/ that
+ * holds a block, in name order. Returns their count. */
+static int managed_files(char (*files)[PATH_MAX])
+{
+    int n = 0;
+    snprintf(files[n++], PATH_MAX, "%s/README.md", UMBRA_SOURCE_DIR);
+    snprintf(files[n++], PATH_MAX, "%s/docs/accuracy.md", UMBRA_SOURCE_DIR);
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/docs", UMBRA_SOURCE_DIR);
+    DIR *d = opendir(dir);
+    if (!d)
+        return n;
+    static char names[MAX_FILES][256];
+    int m = 0;
+    for (struct dirent *e; (e = readdir(d)) != NULL && m < MAX_FILES;) {
+        const size_t len = strlen(e->d_name);
+        if (len < 4 || len >= sizeof names[0] || strcmp(e->d_name + len - 3, ".md") != 0 ||
+            strcmp(e->d_name, "accuracy.md") == 0)
+            continue;
+        snprintf(names[m++], sizeof names[0], "%s", e->d_name);
+    }
+    closedir(d);
+    qsort(names, (size_t)m, sizeof names[0], compare_names);
+    for (int i = 0; i < m && n < MAX_FILES; ++i) {
+        const size_t dl = strlen(dir), nl = strlen(names[i]);
+        if (dl + 1 + nl >= PATH_MAX)
+            continue;
+        char *path = files[n];
+        memcpy(path, dir, dl);
+        path[dl] = '/';
+        memcpy(path + dl + 1, names[i], nl + 1);
+        char *text = read_file(path);
+        if (text && strstr(text, MARK_BEGIN))
+            ++n;
+        free(text);
+    }
+    return n;
+}
+
 int bench_readme(int argc, char **argv)
 {
     job J;
     memset(&J, 0, sizeof J);
-    static char files[2][PATH_MAX];
-    snprintf(files[0], sizeof files[0], "%s/README.md", UMBRA_SOURCE_DIR);
-    snprintf(files[1], sizeof files[1], "%s/docs/accuracy.md", UMBRA_SOURCE_DIR);
     const char *only = NULL;
     snprintf(J.results, sizeof J.results, "%s/bench/results/accuracy", UMBRA_SOURCE_DIR);
     J.scene = "walnut";
@@ -457,12 +502,16 @@ int bench_readme(int argc, char **argv)
             return 2;
         }
     }
+    if (only) {
+        J.readme = only;
+        return process_file(&J, check);
+    }
+    static char files[MAX_FILES][PATH_MAX];
+    const int n = managed_files(files);
     int rc = 0;
-    for (int f = 0; f < 2; ++f) {
-        J.readme = only ? only : files[f];
+    for (int f = 0; f < n; ++f) {
+        J.readme = files[f];
         rc |= process_file(&J, check);
-        if (only)
-            break;
     }
     return rc;
 }
