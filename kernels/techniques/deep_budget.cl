@@ -23,10 +23,9 @@
  * dtau alone weighs every bit of material alike -- error in empty space costs nothing, so a
  * cliff is never smeared over the skin behind it -- but also weighs material deep in shadow as
  * much as the lit face a camera on the light's side sees; dv = v dtau (the light the material
- * takes out) the other way round. sqrt(v) dtau lies between: measured on tests/test_deep_budget.c
- * at 3 nodes, image RMSE against the reference 0.008 (point light in nested shells) and 0.016
- * (thick shell, oblique light), against 0.008 / 0.020 for dtau, 0.014 / 0.018 for dv, 0.009 /
- * 0.022 for the largest error at any node (greedy) and 0.036 / 0.011 for the old streaming merge.
+ * takes out) the other way round. sqrt(v) dtau lies between, and on tests/test_deep_budget.c's
+ * scenes it had the lowest worst case of the weights tried (the figures: docs/performance.md,
+ * "Behind the kernels' comments").
  * Buffer: DEEP_FIXED_BUF nodes; a texel whose fit emits more merges the node of least error
  * (against the buffer as it is then, so such errors add up) while it marches, and before the
  * exact choice (dynamic programming, O(N M^3) for M buffered nodes) the buffer is cut the same

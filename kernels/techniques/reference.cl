@@ -20,20 +20,10 @@
  * along a segment it is split further (segment_refined): at the interpolant's kinks, then at its
  * middle, keeping a split's halves and refining no further where they agree with the whole to
  * 3e-5 of depth, with thresholds relative to the light the segment still receives. A homogeneous
- * medium gives exp(-sigma d) for every h. Measured against an independent float64 integral
- * (tests/test_fidelity.c) at h = 0.25: 2e-6 on a one-voxel sheet under a step transfer function
- * (1.4e-4 with the Gauss rule), 3.7e-4 on a near-singular ramp (5e-4), 1.8e-4 at random points in
- * a structured volume (mean 9e-6). Bonsai (384^2): the reference at step 0.25 against 0.125, RMSE
- * 1e-5, max 8.5e-4. The price is time. Same-session frames (PoCL, 2 loaded cores): bonsai 64^2
- * 6.8 / 5.8 s with the Gauss rule, 1.3 / 1.7 s now (4.2x); Marschner-Lobb 64^3 at 256^2 8.2 / 9.2 s,
- * 6.0 / 5.3 s (1.55x: its rippled isosurface keeps most split candidates refining). Without any
- * refinement either frame costs about 40% of that. Against the old midpoint rule (1/27 of the
- * Gauss rule's bonsai frame, 1/11 of Marschner-Lobb's, measured before) that makes about 6x and
- * 7x. Thresholds of 4e-3 (kinks) and 1.6e-2 (middles) broke the ramp's and the structured volume's
- * bounds; an agreement tolerance of 1e-4 brought the structured volume to 2.7e-4 of its 3e-4, 3e-5
- * costs 20% less than 1e-5 on Marschner-Lobb and hardly anything on the bonsai, whose split
- * candidates are mostly resolved by their first split. The depths are summed (Kahan-compensated)
- * and exponentiated once, so a thin medium keeps its precision at any step
+ * medium gives exp(-sigma d) for every h. Held to an independent float64 integral within the
+ * bounds of tests/test_fidelity.c; the price is time. What it measured, what it costs and why
+ * these thresholds: docs/performance.md, "Behind the kernels' comments". The depths are summed
+ * (Kahan-compensated) and exponentiated once, so a thin medium keeps its precision at any step
  * (1e-6 per voxel over 512 voxels at step 0.01). The march stops once every channel is below
  * 1e-6.
  *
