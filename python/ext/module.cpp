@@ -50,6 +50,14 @@ NB_MODULE(_umbra, m)
         .value("COLORED", UMBRA_TRANSMISSION_COLORED,
                "transmission colour from the light TF's RGB");
 
+    nb::enum_<umbra_render_mode>(m, "RenderMode", "umbra_render_mode: how a view ray combines "
+                                                  "its samples")
+        .value("COMPOSITE", UMBRA_RENDER_COMPOSITE,
+               "emission-absorption compositing, lit and shadowed")
+        .value("MIP", UMBRA_RENDER_MIP, "maximum intensity projection")
+        .value("MINIP", UMBRA_RENDER_MINIP, "minimum intensity projection")
+        .value("AVERAGE", UMBRA_RENDER_AVERAGE, "average intensity projection");
+
     nb::enum_<umbra_projection>(m, "Projection", "umbra_projection")
         .value("PERSPECTIVE", UMBRA_PERSPECTIVE)
         .value("ORTHOGRAPHIC", UMBRA_ORTHOGRAPHIC);

@@ -262,6 +262,9 @@ void bind_options(nb::module_ &m)
                "grey shadows, or coloured from the light transfer function's RGB");
     flag(ro, "preintegrated", &umbra_render_desc::preintegrated,
          "pre-integrated segments: the view ray's, and the convolution technique's light");
+    enum_field(ro, "mode", &umbra_render_desc::mode, "RenderMode",
+               "composite (lit, shadowed), or a projection: mip, minip, average (technique "
+               "none only; docs/features.md)");
     make_repr(ro, "RenderOptions");
 
     nb::class_<umbra_shadow_desc> so(m, "ShadowOptions");
