@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # CI: a short run (60 s each) of the three libFuzzer harnesses (tests/fuzz) on their seed corpora,
 # built with clang, ASan and UBSan in build-fuzz/. Installs clang and its fuzzer runtime if they
-# are missing. A longer run is documented in the README's "Tests and benchmarks" section.
+# are missing. A longer run is documented in docs/testing.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v clang-14 >/dev/null && ! command -v clang >/dev/null ||

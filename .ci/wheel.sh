@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# .ci/wheel.sh [BUILD_DIR]: the wheel route of the README's "Python" section, end to end. Builds
+# .ci/wheel.sh [BUILD_DIR]: the wheel route of docs/usage.md's "Python" section, end to end. Builds
 # the wheel (pip wheel ./python, from a clean CMake tree), repairs it with auditwheel into a
 # manylinux wheel that carries the libraries the module loads (the OpenCL ICD loader, Teem,
 # nifticlib, cJSON, libpng, bzip2), installs it into a fresh venv without system site packages

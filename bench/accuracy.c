@@ -8,7 +8,7 @@
  * ratios from the same run), the shadow structure's memory and light channels, and the image
  * error against the exact reference of the same scene and view (bench/metrics.h: RMSE, PSNR, max
  * and mean absolute error, SSIM on luma). It writes accuracy.csv (one row per run), summary.md,
- * headline.md (the README's headline table), papers.md (the seed papers' timing tables
+ * headline.md (docs/accuracy.md's headline table), papers.md (the seed papers' timing tables
  * re-measured, side by side with the papers' figures) and PNG plots through gnuplot
  * (bench/plot_accuracy.gp): error against time and error against memory, per scene, with the
  * Pareto front. bench/README.md documents the options and the method.

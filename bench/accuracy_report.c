@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* bench/accuracy_report.c: `umbra-bench accuracy`, the outputs written from the results table
  * (bench/accuracy.h): the per-scene Pareto fronts, accuracy.csv, the gnuplot plots
- * (bench/plot_accuracy.gp), headline.md (the README's headline table), summary.md and papers.md
+ * (bench/plot_accuracy.gp), headline.md (docs/accuracy.md's headline), summary.md and papers.md
  * (the seed papers' timing tables beside ours). Nothing here renders; bench/README.md describes
  * the files. */
 #define _POSIX_C_SOURCE 200809L

@@ -21,7 +21,7 @@ static const bench_command commands[] = {
     {"progress", bench_progress,
      "how often a long reference render reports progress and how soon a cancel takes effect"},
     {"readme", bench_readme,
-     "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
+     "rewrite the measured blocks of README.md and docs/ from the accuracy results"},
     {"conformance", bench_conformance,
      "every technique's errors in the conformance suite's cases beside the bounds it asserts"},
     {"features", bench_features,

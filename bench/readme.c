@@ -1,24 +1,29 @@
 // SPDX-License-Identifier: Apache-2.0
-/* bench/readme.c: `umbra-bench readme`, which writes the README's measured sections from the
- * recorded results, so that no figure in the README is typed by hand.
+/* bench/readme.c: `umbra-bench readme`, which writes the measured sections of the README and of
+ * the docs it manages from the recorded results, so that no figure there is typed by hand.
  *
- * The README marks each generated block with a pair of HTML comments:
+ * The files managed: README.md and docs/accuracy.md, which must hold blocks, and any other
+ * .md file in docs/ that holds one (in name order). Each marks each generated block with a pair of HTML
+ * comments:
  *
  *     <!-- umbra-bench readme: NAME -->
  *     ... replaced on every run ...
  *     <!-- umbra-bench readme: end -->
  *
  * NAME is one of:
+ *   choose    the all-scenes part of the headline table (DIR/headline.md): one row per
+ *             technique's headline setting, for the README's "choosing a technique";
  *   headline  the headline table of `umbra-bench accuracy` (DIR/headline.md, itself generated
  *             from accuracy.csv) and the main scene's error-versus-time and error-versus-memory
  *             plots;
  *   gallery   the main scene's pictures from the same run (DIR/images/SCENE/, written by
  *             `--images headline`), one table row each with the build time, render time, memory,
  *             light channels and error read from accuracy.csv.
- * Links are written relative to the README's folder. `--check` changes nothing and exits 1 when
- * the README is out of date (for a pre-commit check). */
+ * Links are written relative to each file's folder. `--check` changes nothing and exits 1 when a
+ * file is out of date (for a pre-commit check and the docs_check test). */
 #define _XOPEN_SOURCE 700
 
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -145,13 +150,28 @@ static int column(char **header, int n, const char *name)
 /* ---- the blocks ------------------------------------------------------------------------------ */
 
 typedef struct job {
-    const char *readme;
+    const char *readme; /* the file being written */
     char results[PATH_MAX]; /* the accuracy results folder */
-    char link[PATH_MAX];    /* the same folder as the README links it */
+    char link[PATH_MAX];    /* the same folder as the file links it */
     const char *scene;
 } job;
 
-static int block_headline(const job *J, text *out)
+/* Appends the lines of s to out, leaving out HTML comments; 0 or -1. */
+static int add_lines(text *out, const char *s)
+{
+    int rc = 0;
+    for (const char *line = s; *line && rc == 0;) {
+        size_t n = strcspn(line, "\n");
+        if (strncmp(line, "<!--", 4) != 0)
+            rc = text_add(out, line, n) || text_add(out, "\n", 1);
+        line += n + (line[n] == '\n');
+    }
+    return rc;
+}
+
+/* DIR/headline.md into out: the whole table, or (all_scenes) its all-scenes part, from its
+ * "**All " line to the end. 0, or -1 after a message. */
+static int add_headline(const job *J, text *out, int all_scenes)
 {
     char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/headline.md", J->results);
@@ -161,14 +181,18 @@ static int block_headline(const job *J, text *out)
                 strerror(errno));
         return -1;
     }
-    int rc = 0;
-    for (char *line = md; *line && rc == 0;) {
-        size_t n = strcspn(line, "\n");
-        if (strncmp(line, "<!--", 4) != 0)
-            rc = text_add(out, line, n) || text_add(out, "\n", 1);
-        line += n + (line[n] == '\n');
-    }
+    const char *from = all_scenes ? strstr(md, "\n**All ") : md;
+    if (!from)
+        fprintf(stderr, "readme: %s has no all-scenes table ('**All N scenes**')\n", path);
+    int rc = from ? add_lines(out, from + (from != md)) : -1;
     free(md);
+    return rc;
+}
+
+static int block_headline(const job *J, text *out)
+{
+    char path[PATH_MAX + 64];
+    int rc = add_headline(J, out, 0);
     const char *kinds[] = {"time", "memory"};
     int plots = 0;
     for (int i = 0; i < 2 && rc == 0; ++i) {
@@ -183,6 +207,9 @@ static int block_headline(const job *J, text *out)
         rc = text_add(out, "\n", 1);
     return rc;
 }
+
+/* The headline table's all-scenes part, for the README's choice of a technique. */
+static int block_choose(const job *J, text *out) { return add_headline(J, out, 1); }
 
 static int block_gallery(const job *J, text *out)
 {
@@ -290,11 +317,13 @@ static int regenerate(const job *J, const char *src, text *out)
         int rc;
         if (strcmp(block, "headline") == 0)
             rc = block_headline(J, out);
+        else if (strcmp(block, "choose") == 0)
+            rc = block_choose(J, out);
         else if (strcmp(block, "gallery") == 0)
             rc = block_gallery(J, out);
         else {
-            fprintf(stderr, "readme: %s: unknown block '%s' (headline, gallery)\n", J->readme,
-                    block);
+            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery)\n",
+                    J->readme, block);
             rc = -1;
         }
         if (rc != 0)
@@ -309,11 +338,15 @@ static int regenerate(const job *J, const char *src, text *out)
     return text_add(out, p, strlen(p));
 }
 
-/* J->link: J->results as seen from the README's folder (relative when it lies inside it). */
+/* J->link: J->results as seen from the file's folder (relative when it lies inside it). */
 static void link_path(job *J)
 {
     char dir[PATH_MAX], rdir[PATH_MAX], racc[PATH_MAX];
-    snprintf(dir, sizeof dir, "%s", J->readme);
+    size_t len = strlen(J->readme);
+    if (len >= sizeof dir)
+        len = sizeof dir - 1;
+    memcpy(dir, J->readme, len);
+    dir[len] = '\0';
     char *slash = strrchr(dir, '/');
     if (slash)
         *slash = '\0';
@@ -322,33 +355,132 @@ static void link_path(job *J)
     snprintf(J->link, sizeof J->link, "%s", J->results);
     if (!realpath(dir, rdir) || !realpath(J->results, racc))
         return;
-    size_t n = strlen(rdir);
-    if (strncmp(racc, rdir, n) == 0 && racc[n] == '/')
-        snprintf(J->link, sizeof J->link, "%s", racc + n + 1);
-    else
+    /* The longest common prefix of whole components; then one "../" per component of rdir
+     * past it. With nothing in common but the root, the absolute path. */
+    size_t common = 0;
+    for (size_t i = 0;; ++i) {
+        const int rend = rdir[i] == '\0' || rdir[i] == '/';
+        const int aend = racc[i] == '\0' || racc[i] == '/';
+        if (rend && aend)
+            common = i;
+        if (rdir[i] == '\0' || racc[i] == '\0' || rdir[i] != racc[i])
+            break;
+    }
+    if (common == 0) {
         snprintf(J->link, sizeof J->link, "%s", racc);
+        return;
+    }
+    char up[PATH_MAX] = "";
+    size_t n = 0;
+    for (const char *s = rdir + common; *s && n + 4 < sizeof up; ++s)
+        if (*s == '/') {
+            memcpy(up + n, "../", 4);
+            n += 3;
+        }
+    const char *rest = racc + common + (racc[common] == '/');
+    if (snprintf(J->link, sizeof J->link, "%s%s", up, *rest ? rest : ".") >= (int)sizeof J->link)
+        snprintf(J->link, sizeof J->link, "%s", racc); /* too deep for a relative link */
 }
 
 static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
                "[--check]\n"
-               "  rewrites the README's '" MARK_BEGIN "headline|gallery -->' blocks from the\n"
-               "  results of `umbra-bench accuracy`\n"
-               "  --readme FILE   default <source>/README.md\n"
+               "  rewrites the '" MARK_BEGIN "choose|headline|gallery -->' blocks of README.md,\n"
+               "  docs/accuracy.md and any other docs/*.md holding one, from the results of\n"
+               "  `umbra-bench accuracy`\n"
+               "  --readme FILE   only this file\n"
                "  --results DIR   default <source>/bench/results/accuracy\n"
                "  --scene NAME    the scene of the plots and pictures (default walnut)\n"
-               "  --check         change nothing; exit 1 if the README is out of date\n");
+               "  --check         change nothing; exit 1 if a file is out of date\n");
+}
+
+/* Regenerates one file (J->readme); with check, only compares. 0, or 1 after a message. */
+static int process_file(job *J, int check)
+{
+    link_path(J);
+    char *src = read_file(J->readme);
+    if (!src) {
+        fprintf(stderr, "readme: cannot read %s: %s\n", J->readme, strerror(errno));
+        return 1;
+    }
+    text out = {0};
+    int rc = regenerate(J, src, &out) == 0 ? 0 : 1;
+    if (rc == 0 && strcmp(out.s, src) != 0) {
+        if (check) {
+            fprintf(stderr, "readme: %s is out of date: run umbra-bench readme\n", J->readme);
+            rc = 1;
+        } else {
+            FILE *f = fopen(J->readme, "wb");
+            if (!f || fwrite(out.s, 1, out.len, f) != out.len) {
+                fprintf(stderr, "readme: cannot write %s: %s\n", J->readme, strerror(errno));
+                rc = 1;
+            }
+            if (f && fclose(f) != 0)
+                rc = 1;
+            if (rc == 0)
+                fprintf(stderr, "readme: updated %s\n", J->readme);
+        }
+    } else if (rc == 0) {
+        fprintf(stderr, "readme: %s is up to date\n", J->readme);
+    }
+    free(out.s);
+    free(src);
+    return rc;
+}
+
+#define MAX_FILES 64
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp((const char *)a, (const char *)b);
+}
+
+/* The files to manage: README.md, docs/accuracy.md, then every other .md file in docs/ that
+ * holds a block, in name order. Returns their count. */
+static int managed_files(char (*files)[PATH_MAX])
+{
+    int n = 0;
+    snprintf(files[n++], PATH_MAX, "%s/README.md", UMBRA_SOURCE_DIR);
+    snprintf(files[n++], PATH_MAX, "%s/docs/accuracy.md", UMBRA_SOURCE_DIR);
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/docs", UMBRA_SOURCE_DIR);
+    DIR *d = opendir(dir);
+    if (!d)
+        return n;
+    static char names[MAX_FILES][256];
+    int m = 0;
+    for (struct dirent *e; (e = readdir(d)) != NULL && m < MAX_FILES;) {
+        const size_t len = strlen(e->d_name);
+        if (len < 4 || len >= sizeof names[0] || strcmp(e->d_name + len - 3, ".md") != 0 ||
+            strcmp(e->d_name, "accuracy.md") == 0)
+            continue;
+        snprintf(names[m++], sizeof names[0], "%s", e->d_name);
+    }
+    closedir(d);
+    qsort(names, (size_t)m, sizeof names[0], compare_names);
+    for (int i = 0; i < m && n < MAX_FILES; ++i) {
+        const size_t dl = strlen(dir), nl = strlen(names[i]);
+        if (dl + 1 + nl >= PATH_MAX)
+            continue;
+        char *path = files[n];
+        memcpy(path, dir, dl);
+        path[dl] = '/';
+        memcpy(path + dl + 1, names[i], nl + 1);
+        char *text = read_file(path);
+        if (text && strstr(text, MARK_BEGIN))
+            ++n;
+        free(text);
+    }
+    return n;
 }
 
 int bench_readme(int argc, char **argv)
 {
     job J;
     memset(&J, 0, sizeof J);
-    char readme[PATH_MAX];
-    snprintf(readme, sizeof readme, "%s/README.md", UMBRA_SOURCE_DIR);
+    const char *only = NULL;
     snprintf(J.results, sizeof J.results, "%s/bench/results/accuracy", UMBRA_SOURCE_DIR);
-    J.readme = readme;
     J.scene = "walnut";
     int check = 0;
     for (int i = 1; i < argc; ++i) {
@@ -359,7 +491,7 @@ int bench_readme(int argc, char **argv)
         } else if (strcmp(a, "--check") == 0) {
             check = 1;
         } else if (i + 1 < argc && strcmp(a, "--readme") == 0) {
-            J.readme = argv[++i];
+            only = argv[++i];
         } else if (i + 1 < argc && strcmp(a, "--results") == 0) {
             snprintf(J.results, sizeof J.results, "%s", argv[++i]);
         } else if (i + 1 < argc && strcmp(a, "--scene") == 0) {
@@ -370,33 +502,16 @@ int bench_readme(int argc, char **argv)
             return 2;
         }
     }
-    link_path(&J);
-    char *src = read_file(J.readme);
-    if (!src) {
-        fprintf(stderr, "readme: cannot read %s: %s\n", J.readme, strerror(errno));
-        return 1;
+    if (only) {
+        J.readme = only;
+        return process_file(&J, check);
     }
-    text out = {0};
-    int rc = regenerate(&J, src, &out) == 0 ? 0 : 1;
-    if (rc == 0 && strcmp(out.s, src) != 0) {
-        if (check) {
-            fprintf(stderr, "readme: %s is out of date: run umbra-bench readme\n", J.readme);
-            rc = 1;
-        } else {
-            FILE *f = fopen(J.readme, "wb");
-            if (!f || fwrite(out.s, 1, out.len, f) != out.len) {
-                fprintf(stderr, "readme: cannot write %s: %s\n", J.readme, strerror(errno));
-                rc = 1;
-            }
-            if (f && fclose(f) != 0)
-                rc = 1;
-            if (rc == 0)
-                fprintf(stderr, "readme: updated %s\n", J.readme);
-        }
-    } else if (rc == 0) {
-        fprintf(stderr, "readme: %s is up to date\n", J.readme);
+    static char files[MAX_FILES][PATH_MAX];
+    const int n = managed_files(files);
+    int rc = 0;
+    for (int f = 0; f < n; ++f) {
+        J.readme = files[f];
+        rc |= process_file(&J, check);
     }
-    free(out.s);
-    free(src);
     return rc;
 }

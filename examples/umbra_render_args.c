@@ -189,7 +189,7 @@ static const fixed_option fixed[] = {
                                  "nearest voxel, label l taking entry l of the transfer function "
                                  "(in the text format: resolution L, label l's point at value "
                                  "l/(L-1))"},
-    {"tf", OPT_TF, "FILE", "transfer function: text format (see README) or a ParaView preset "
+    {"tf", OPT_TF, "FILE", "transfer function: text format (docs/usage.md) or a ParaView preset "
                            ".json (x in the volume's data units)"},
     {"tf-preset", OPT_TF_PRESET, "NAME", "the preset to pick from a .json holding several"},
     {"light-tf", OPT_LIGHT_TF, "FILE", "separate transfer function for the light pass"},
@@ -768,7 +768,7 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
                 givens[ngiven++] = (given){"seed", "seed", v, 0.0};
             break;
         case OPT_DEVICE: {
-            /* P:D (platform and device indices) as the README documents, else a name substring. */
+            /* P:D (platform and device indices) as docs/usage.md has it, else a name substring. */
             uint32_t pd[2];
             if (parse_u32_list(v, ':', 2, 0, 1023, pd)) {
                 o->platform_index = (int)pd[0];

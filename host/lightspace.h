@@ -26,7 +26,7 @@ double umbra__lightspace_setup(umbra_renderer r, uint32_t map_size);
  * and CSSM's within 1.6% either way (its noise, not its step, sets its error) for builds
  * 0.64x-0.83x. Both find their event within a segment from the segment's optical depth, so the
  * step only sets where the volume is sampled: once a voxel, the data's own spacing. The deep
- * map's error grew 1.09x-1.24x at a step of 1 (its nodes follow the sampled visibility; README),
+ * map's error grew 1.09x-1.24x at a step of 1 (its nodes follow the sampled visibility; docs/),
  * so it keeps 0.5. A map technique's light_step. */
 float umbra__map_light_step(const umbra_shadow_desc *d);
 

@@ -7,7 +7,7 @@
  * Why umbra reads MetaImage itself. The one MetaImage library Debian 12 ships is MetaIO, inside
  * ITK (libITKMetaIO-5.2, in libinsighttoolkit5-dev, 33 packages) and again inside VTK
  * (vtkmetaio, libvtk9-dev, 118 packages). It was measured before this file was written (see the
- * README's formats section) and fails what umbra_io must do with a file from anywhere:
+ * docs/usage.md's volume files) and fails what umbra_io must do with a file from anywhere:
  *   - a header "NDims = 5000" followed by 5000 DimSize values makes MET_Read write past its
  *     4096-value field record (valgrind: invalid write of size 8 in MET_Read); upstream MetaIO
  *     still reads arrays of NDims values unchecked;

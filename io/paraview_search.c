@@ -2,7 +2,7 @@
 /* io/paraview_search.c: finding a ParaView preset by its name (umbra_transfer_function_load_paraview
  * with no path, umbra_transfer_function_load with a name, `--tf "Cool to Warm"`).
  *
- * The search path, in order (umbra/io.h and the README say the same):
+ * The search path, in order (umbra/io.h and docs/usage.md say the same):
  *   1. each directory of $UMBRA_PRESET_PATH (':'-separated), when set;
  *   2. the presets installed with umbra: share/umbra/presets of the prefix holding the library
  *      (or the program that links umbra_io statically), found from the loaded object's own path

@@ -153,16 +153,10 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
          * point depends on the sample's opacity, shadow_point, and the lookup's texels on the
          * light point). The opacity is composited at once, so termination and the samples taken
          * are unchanged, and each colour is added in the same order with the same weight: the
-         * image is the same bit for bit. Camera orbits with the map cached, over the unshadowed
-         * frame, walnut and bonsai, shading on and off (issue #12): threshold 1.33x-1.62x ->
-         * 1.18x-1.48x, CSSM 1.37x-1.90x -> 1.30x-1.79x, deep 1.45x-2.4x -> 1.32x-2.1x; the
-         * unshadowed frame unchanged. The light point (l_pend) is computed when the sample is
-         * composited, where its opacity is at hand, not at the lookup: the same arithmetic,
-         * placed where the processor can start it a sample earlier. Camera orbits, old and new
-         * in turn (three or four runs each): walnut CSSM 1.34x -> 1.28x shaded and 1.55x ->
-         * 1.48x unshaded, deep 1.65x -> 1.52x and 1.98x -> 1.90x, threshold 1.23x -> 1.17x
-         * shaded; bonsai CSSM 1.27x -> 1.21x and 1.36x -> 1.33x, deep 1.33x -> 1.29x and 1.47x
-         * -> 1.43x; the unshaded threshold map unchanged. */
+         * image is the same bit for bit. The light point (l_pend) is computed when the sample
+         * is composited, where its opacity is at hand, not at the lookup: the same arithmetic,
+         * placed where the processor can start it a sample earlier. What both gained:
+         * docs/performance.md, "Behind the kernels' comments" (issue #12). */
         int pending = 0;
         float3 p_pend = (float3)(0.0f), l_pend = (float3)(0.0f);
         float4 c_pend = (float4)(0.0f);

@@ -290,7 +290,7 @@ static void test_budget_thick_shell_oblique_light(void **state)
  * The deep map's lookup takes the nearest texel (as the paper's does), so at the edge of thin
  * material the map aliases at its texel size: a one-voxel board lit obliquely, its shadow on the
  * ground plane and on itself. The largest pixel error against the reference must stay within a
- * stated bound and shrink as the map grows (README, "Deep shadow map"). */
+ * stated bound and shrink as the map grows (docs/techniques.md, "Deep shadow map"). */
 static float board_value(int i, int j, int k)
 {
     const double c = 0.5 * N_VOX - 0.5, x = i - c, y = j - c, z = k - c;

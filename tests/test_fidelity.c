@@ -17,7 +17,7 @@
  *  - and, rendered: an alpha = 1 sphere's lit face equals the unshadowed image to 0.02, with and
  *    without jitter (no speckles); a homogeneous dense box renders with jitter as without it
  *    (RMSE 0.01, issue #29.12).
- * Each bound is also stated in docs/hard-cases.md. */
+ * Each bound is also stated in docs/hard-cases.md and docs/techniques.md ("Hard cases"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

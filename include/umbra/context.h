@@ -93,10 +93,10 @@ typedef struct umbra_context_t *umbra_context;
 
 /* How volumes are sampled on the device: a plain buffer with hand-written trilinear
  * interpolation in float, or a 3D image with the sampler's linear filtering. AUTO is the buffer
- * on every device. On PoCL the buffer measured about 3x faster. On an NVIDIA H200 the image was
- * at most 1.3x faster per frame, but its texture filter's interpolation weights (9-bit fixed
- * point in CUDA's documentation) put shaded bonsai pixels up to 0.235 off the plain-C twin, the
- * buffer 0.0015. IMAGE, where the device has single-channel float 3D images, is for comparison. */
+ * on every device: faster on PoCL, and exact where a GPU's texture filter interpolates with
+ * fixed-point weights (9 bits in CUDA's documentation), which shading and sharp transfer
+ * functions magnify (measured: docs/architecture.md, "Samplers"; docs/performance.md).
+ * IMAGE, where the device has single-channel float 3D images, is for comparison. */
 typedef enum umbra_sampler_kind {
     UMBRA_SAMPLER_AUTO = 0,
     UMBRA_SAMPLER_BUFFER = 1,

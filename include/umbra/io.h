@@ -112,7 +112,7 @@ UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *pa
 UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
                                                    umbra_volume *out);
 
-/* Loads a DICOM volume (Part 10 files, read by umbra itself: see the README): count files of one
+/* Loads a DICOM volume (Part 10 files, read by umbra itself: see docs/usage.md): count files of one
  * series in any order, one directory (its files, DICOMDIR and names starting with '.' passed
  * over, subdirectories not entered), or one single-frame file. Greyscale, 8 or 16 bits
  * allocated; implicit or explicit VR little endian, uncompressed or RLE Lossless (JPEG, JPEG-LS,
@@ -169,7 +169,7 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
 
 /* ---- transfer functions ---------------------------------------------------------------------- */
 
-/* Reads the text format documented in the README (and io/tf_file.c): '#' comments, optional
+/* Reads the text format documented in docs/usage.md (and io/tf_file.c): '#' comments, optional
  * lines "resolution N" (2..65536, default 256) and "range LO HI" (finite, LO < HI) before the
  * first point, then one control point "value r g b a" per line (at most UMBRA_TF_MAX_POINTS),
  * values ascending (equal values make a step): in [0,1] of the volume's normalised range, or with
@@ -207,7 +207,7 @@ UMBRA_API void umbra_paraview_options_init(umbra_paraview_options *options);
 
 /* Reads a ParaView JSON colour-map preset (RGBPoints, Points with midpoint and sharpness,
  * ColorSpace RGB / HSV / Lab / CIELAB / Diverging / Step, HSVWrap; categorical IndexedColors with
- * Annotations; see the README) and evaluates it into a table of options->resolution entries
+ * Annotations; see docs/usage.md) and evaluates it into a table of options->resolution entries
  * over a data range: the preset's own (smallest to largest x of its points; a categorical
  * preset's values +-0.5) or options' range, and gives the table that data range
  * (umbra_transfer_function_set_range), so renderers place it over each volume's values in data

@@ -172,14 +172,14 @@ UMBRA_API umbra_status umbra_shadow_technique_parse(const char *name, umbra_shad
  * map_texels_per_voxel: 1 for the threshold map, one depth per texel: finer maps sample the same
  * voxels again; 3 for CSSM, whose taps are fixed in texels, radius 4 for 13 taps, so fewer texels
  * per voxel blur the shadow over several voxels; 2 for the deep map, a nearest-texel lookup whose
- * error keeps falling with the size; README, "Map size"). A directional light's orthographic map
+ * error keeps falling with the size; docs/techniques.md, "Map size"). A directional light's map
  * gets k times the wider side of the box's projection in voxels; a point light's frustum the same
  * measured at the distance of the box's centre (the near side gets more texels per voxel, the far
  * side fewer); a point light inside or near the box (octahedral map over every direction)
  * k sqrt(4 pi) R / voxel, R the distance to the farthest corner. texels_per_voxel replaces k where
  * it is set: an application that rebuilds the map every frame while the user drags the light can
- * ask for 1 (a draft at the threshold map's size: CSSM builds 5x to 8x faster, the deep map 3x to
- * 4x; README "Map size") and go back to 0 when the light stops. The result is rounded up to a
+ * ask for 1 (a draft at the threshold map's size, cheaper to build; what it costs and saves:
+ * docs/accuracy.md) and go back to 0 when the light stops. The result is rounded up to a
  * multiple of UMBRA_MAP_SIZE_AUTO_ROUND (whole deep-map tiles) and bounded to
  * [UMBRA_MAP_SIZE_AUTO_MIN, UMBRA_MAP_SIZE_AUTO_MAX]. It is chosen again whenever the map is
  * rebuilt (the light or volume changed); umbra_render_stats.map_size says what was chosen. On the
@@ -200,7 +200,7 @@ typedef struct umbra_map_desc {
                                [0.25, 8]; a fixed size ignores it */
     float step;             /* light-ray step in voxels: 0 (the default: the technique's own,
                                umbra_technique_info.map_step: 1 for the threshold map and CSSM,
-                               0.5 for the deep map, README "Map size") or [0.01, 64] */
+                               0.5 for the deep map, docs/techniques.md) or [0.01, 64] */
 } umbra_map_desc;
 
 /* The shadow technique and the parameters of every technique, each in its own member (the
@@ -382,9 +382,9 @@ UMBRA_API umbra_status umbra_renderer_get_stats(umbra_renderer r, umbra_render_s
  * of the call's work done: in [0, 1], non-decreasing, and exactly 1 in the last call of a call
  * that succeeds. Pieces are sized to about 2^24 samples of the work's upper bound, shadow and
  * light rays included (a reference render marches a shadow ray from every view sample), but at
- * least four work-groups per compute unit on a CPU (docs/performance.md: a reference render of
- * 512^2 at steps 0.25 and 0.05 on 2 loaded cores reported at most 0.43 s apart and stopped
- * within 0.27 s of a cancel; it had stopped 119 s after one). Return nonzero to cancel: the
+ * least four work-groups per compute unit on a CPU, so that reports come at most a fraction of a
+ * second apart and a cancel takes effect within two pieces (measured: docs/performance.md,
+ * "Progress and cancel that follow the work"). Return nonzero to cancel: the
  * call waits for the piece in flight, then returns UMBRA_ERROR_CANCELLED; the renderer stays
  * usable (the next render rebuilds what was cut short). The callback must not call this
  * renderer: any call on it from the callback (or from another thread meanwhile) is refused with

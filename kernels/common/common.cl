@@ -157,8 +157,8 @@ inline float umbra_random(uint seed, uint a, uint b, uint c)
 
 /* floor(x) as integers, for |x| < 2^31: a conversion (truncation toward zero) and one less where
  * that rounded up (x negative, not whole). PoCL's floor() is a dozen instructions, since it also
- * handles huge and infinite values; in the sample and lookup loops that was a tenth of the
- * unshadowed frame (issue #12). */
+ * handles huge and infinite values; in the sample and lookup loops that was a noticeable part
+ * of the unshadowed frame (docs/performance.md; issue #12). */
 inline int2 floor_int2(float2 x)
 {
     const int2 i = convert_int2(x);
@@ -174,9 +174,8 @@ inline int3 floor_int3(float3 x)
 /* |v| and v / |v| where they run per sample. PoCL's length() and normalize() guard against
  * overflow and underflow by scaling, which costs several times the square root; the vectors here
  * (gradients, offsets within the scene) are far from either, and the results were the same bit
- * for bit on every image checked. Unshaded walnut camera orbit over the unshadowed frame with
- * the map cached, old and new in turn: threshold 1.46x -> 1.42x, CSSM 1.66x -> 1.58x (issue
- * #12). */
+ * for bit on every image checked. What it gained: docs/performance.md, "Behind the kernels'
+ * comments" (issue #12). */
 inline float umbra_length(float3 v) { return sqrt(dot(v, v)); }
 
 inline float3 umbra_normalize(float3 v) { return v * (1.0f / sqrt(dot(v, v))); }
@@ -452,8 +451,8 @@ inline float4 to_light(__global const UmbraFrame *F, float3 p)
 }
 
 /* x^n for x in [0, 1] and n > 0: Blinn-Phong's specular |N.H|^shininess. pow() was the costliest
- * call of a shaded sample on PoCL (a shaded bonsai frame took 2.2x the unshaded one with it,
- * 1.15x without): it handles every sign, range and exponent and rounds nearly exactly. A whole
+ * call of a shaded sample on PoCL (docs/performance.md, "Behind the kernels' comments"): it
+ * handles every sign, range and exponent and rounds nearly exactly. A whole
  * exponent up to UMBRA_POWER_BY_SQUARING, as shininess almost always is, is taken by binary
  * powering instead: at most 2 log2(n) multiplications, each adding half an ulp, whose errors
  * the squarings double, so the result is within (n - 1) 2^-24 relative of the exact power (6e-6

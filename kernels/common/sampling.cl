@@ -12,7 +12,7 @@
  * (voxel_normalise, constants in VolGeom from UmbraFrame.value_map). The mapping is linear
  * until it clamps, so where no voxel lies outside the value range (UMBRA_VOXEL_CLAMPS 0, a build
  * option from the volume) the sampler blends the stored values and maps the result once, which
- * keeps the buffer path as fast as the float volume was (per-corner mapping cost 20% of a
+ * keeps the buffer path as fast as the float volume was (per-corner mapping cost much of a
  * frame); where a given range clamps voxels, the buffer path maps each of the eight corners
  * before blending, so values outside the range clamp before they blend, as the float volume
  * did. The image path's filter always blends first: the host stores a normalised float image
@@ -282,10 +282,9 @@ inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * the 32 voxels those six samples read (a 4 x 2 x 2 block through p's cell along each axis):
  * as all six share p's fractions, each axis' component is the trilinear interpolation, over p's
  * cell, of the voxels' central differences v[i+1] - v[i-1]. Six separate samples cost 48 loads
- * and six index computations: on PoCL a shaded 256^2 bonsai frame took 1.38x the unshaded one
- * with them, 1.23-1.29x with this (both with kernels/common/common.cl's shading_power; frames of
- * one
- * run each, on a loaded 2-core machine). Indices come from the unclamped position and are
+ * and six index computations, which made PoCL's shaded frames markedly costlier than this
+ * (measured: docs/performance.md, "Behind the kernels' comments"). Indices come from the
+ * unclamped position and are
  * clamped one by one, which repeats the border voxels exactly as clamping each sample's
  * position does (a position clamped to the border interpolates between two copies of the
  * border voxel). It differs from

@@ -28,11 +28,10 @@
  *    where the optical depth passes its E, until the last one (in every channel) is stopped. The
  *    host's default B is the map's whole texels per voxel, at most 3, so that the rays a block
  *    stands for would cross the same voxels: at auto sizes (3 texels per voxel) that is a ninth
- *    of the rays, each marched until the deepest of nine photons stops. Measured with umbra-bench
- *    accuracy on all seven bench scenes, against a ray per texel (ray_block 1) in the same run:
- *    RMSE 1.00x-1.01x, builds 0.18x-0.40x at auto and 1024^2 (README, "Colored stochastic shadow
- *    map"). The taps of a lookup (radius >= 4 texels) fall in other blocks, so the average still
- *    draws on 13 rays.
+ *    of the rays, each marched until the deepest of nine photons stops; the error and build
+ *    time against a ray per texel (ray_block 1) are in docs/techniques.md (CSSM) and
+ *    docs/performance.md. The taps of a lookup (radius >= 4 texels) fall in other blocks, so
+ *    the average still draws on 13 rays.
  *
  * Segments: whole steps of S->step plus one partial step, sampled at their midpoints, each with
  * the optical depth of its length, so the product of the (1 - rho_i) along a whole ray is the
@@ -73,8 +72,8 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 
 /* light_depth (kernels/common/common.cl) without its library call: the march needs a segment's
  * optical
- * depth at every segment of material, and PoCL's log1p, a call per segment, was a fifth of a
- * build (1.3x-1.6x the builds of a per-segment test that mostly avoided it). For alpha up to 0.5,
+ * depth at every segment of material, and PoCL's log1p, a call per segment, was a large part of
+ * a build (docs/performance.md, "Behind the kernels' comments"). For alpha up to 0.5,
  * -ln(1 - a) = 2 atanh(s) with s = a / (2 - a) <= 1/3, summed to s^13: within 1.8 float epsilons
  * of the exact value at every float a in (0, 0.5] (checked against a double log1p), where
  * log1p is within 0.7; above 0.5, 1 - a is exact and a plain logarithm serves (rare: such a

@@ -42,9 +42,8 @@
 /* Sub-texel rays per texel (desc->prefilter, 1 or 5), a build option of the build program, not a
  * kernel argument: with the count known the compiler sizes the per-ray arrays to it and can
  * unroll the loops over the rays. The arithmetic and its order are unchanged, so the maps are
- * the same bit for bit; the 1-ray build on the walnut (512^2) took 0.97x the time of the
- * run-time count (two interleaved runs each, issue #12): less than hoped, the march itself is
- * the cost. */
+ * the same bit for bit; the gain is small, the march itself is the cost (docs/performance.md,
+ * "Behind the kernels' comments"; issue #12). */
 #ifndef DEEP_SUB_RAYS
 #define DEEP_SUB_RAYS 1
 #endif
@@ -271,8 +270,8 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
          * this greedy fit. Every feasible fit writes its nodes as it goes, so none is fitted
          * again: the entry is the first fit's if it is feasible, else the last feasible
          * halving's, else the line's. Fitting the chosen tolerance once more, as this did
-         * before, took the table 1.18x the CPU time (perf samples over the walnut's opacity
-         * sequence, the same table bit for bit, issue #12). */
+         * before, cost the table more CPU time for the same table bit for bit
+         * (docs/performance.md, "Behind the kernels' comments"; issue #12). */
         int interior = deep_lut_fit(v, DEEP_LUT_TOL, DEEP_LUT_INTERIOR, out);
         if (interior > DEEP_LUT_INTERIOR) {
             float lo = DEEP_LUT_TOL, hi = DEEP_LUT_TOL;
@@ -428,8 +427,8 @@ inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
  * counted to either side, as the threshold map's and CSSM's walks count theirs. Truncation stands
  * for floor: they differ only below 0, which the clamp takes to 0 either way (and x lies in the
  * box, far from the int range). In its earlier form (a division and floor() per axis, and both
- * ends located afresh every step) the test took about a fifth of a deep build in a profile;
- * this one and the cache in deep_step made builds 0.80x-0.88x (issue #12). */
+ * ends located afresh every step) the test was a large part of a deep build in a profile;
+ * this one and the cache in deep_step made builds cheaper (docs/performance.md; issue #12). */
 inline int deep_point_class(VolGeom g, __global const ulong *cells, float3 x, float inv_B,
                             float inv_C, int last)
 {
@@ -473,8 +472,8 @@ inline int deep_quant(float s)
 /* Marches one segment (or jumps over empty bricks or sub-cells) and feeds the fit; writes the emitted nodes
  * to e and returns their number (at most DEEP_MAX_EMIT: one per distinct position, one for the
  * gap point, one for the fit's first node, three when the ray ends). Sets T->done at the end.
- * Always inlined: called, it kept the texel's state in memory, and the 3-node build on the walnut
- * took 2.28x the threshold map's CPU time on PoCL instead of 2.11x (512^2, same run). */
+ * Always inlined: called, it kept the texel's state in memory, and the build was slower on PoCL
+ * (docs/performance.md, "Behind the kernels' comments"). */
 UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
                            __global const float4 *light_tf, __global const ulong *light_cells,
                            __global const UmbraShadow *S, __global const deep_node *lut,

@@ -36,18 +36,8 @@
  * them, and a large budget can then come closer to the reference than the unbounded map. And
  * the flat stretch behind the material (to the box's far side) costs no node of the budget
  * (deep_fixed_trim_tail).
- * Image RMSE against the reference at 3 nodes (tests/test_deep_budget.c, test_deep_fidelity.c,
- * PoCL): nested shells round a point light 0.010 (0.011 with the trapezoid, sqrt(v), the fit
- * within epsilon everywhere and the tail's node, before 2026-12-01), a thick shell lit obliquely
- * 0.010 (0.016), the head phantoms 0.011 and 0.011 (0.028 and 0.026, with 4.7% and 4.2% of their
- * pixels off by more than 0.1), the spheres with the light inside 0.008 and 0.010 (0.009 and
- * 0.010; largest pixel error 0.14 and 0.15, the budget's own: 8 nodes 0.055 and 0.043, as the
- * unbounded map). Earlier measures on the first two: dtau alone 0.008 / 0.020, dv 0.014 / 0.018,
- * the largest error at any node (greedy) 0.009 / 0.022, the old streaming merge 0.036 / 0.011.
- * With the rest as now, sqrt(v) for a light inside gives the heads 0.016 / 0.012, dv 0.027. The
- * exact integral makes the walnut's 3-node build (a point light outside) 1.09x-1.15x as long
- * (200 x 150, builds of the old and new code in turn), the finer fit the spheres' with the light
- * inside about 1.3x.
+ * Held to the reference by tests/test_deep_budget.c and test_deep_fidelity.c; the measured
+ * errors and costs of these choices: docs/hard-cases.md.
  * Buffer: DEEP_FIXED_BUF nodes; a texel whose fit emits more merges the node of least error
  * (against the buffer as it is then, so such errors add up) while it marches, and before the
  * exact choice (dynamic programming, O(N M^3) for M buffered nodes) the buffer is cut the same

@@ -29,21 +29,9 @@
  * so a thin medium keeps its precision at any step (1e-6 per voxel over 512 voxels at step 0.01).
  * The march stops once every channel is below 1e-6.
  *
- * Measured against an independent float64 integral (tests/test_fidelity.c, test_alignment.c):
- * at h = 0.25, 2.9e-6 on a one-voxel sheet under a step transfer function, 2.8e-7 on a
- * near-singular ramp, 2.9e-5 at random points in a structured volume (mean 3.5e-7); kinks placed
- * on steps' boundaries and middles, and random voxels under a light on a lattice point, 4e-6 at
- * every step from 1/16 to 1. Until 2026-12-01 the volume was sampled at the steps' ends and a
- * step split at the one kink nearest its middle, only where the extinction at its two ends
- * differed: a peak centred on a step, whose ends then have one value, was missed whole (issue
- * #29: 0.027 at step 0.25, 0.17 at step 1), and the structured volume was off by 1.8e-4. The
- * cost, frames of the old and the new reference in turn (PoCL on the 2-core machine while other
- * builds ran, so the process's CPU time per frame, medians of 3 after a warm-up): the walnut at
- * 200 x 150, 1.04x and 0.94x the old frame; the spheres (128^3) at 192^2, 1.05x and 1.06x. The
- * walk's one load of eight voxels per cell replaces a trilinear sample per step: without the
- * correction and the refinement a frame takes 0.8x; refining every candidate down to 3e-5
- * instead of stopping where the halves agree took 1.9x, a candidate threshold of 3e-5 instead
- * of 1e-4 1.2x (the structured volume at 1.2e-5).
+ * Held to an independent float64 integral within the bounds of tests/test_fidelity.c and
+ * tests/test_alignment.c (kinks on steps' boundaries and middles, lights on lattice points); what
+ * it measured, what the walk costs and what it replaced (until 2026-12-01): docs/hard-cases.md.
  *
  * Empty-space skipping: the ray walks the light's sub-cell masks too and integrates only inside
  * visible sub-cells: in an invisible one the light transfer function leaves every value the

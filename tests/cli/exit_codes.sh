@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tests/cli/exit_codes.sh UMBRA_RENDER: umbra-render's exit statuses and strict number parsing
-# against the README ("bad input exits 1 with a message naming the problem; a failure on the
+# against docs/usage.md ("bad input exits 1 with a message naming the problem; a failure on the
 # device exits 2"), issue 11 rows 2, 10 and 11. Each case runs the CLI on a tiny image and checks
 # the status, a piece of the message, and for output paths that nothing was rendered first.
 set -uo pipefail

@@ -18,7 +18,7 @@ typedef struct umbra_cssm_desc {
                            (through the block's centre; each photon keeps its own random
                            number): 0 (the default: the map's whole texels per voxel, at most 3,
                            so that a block spans no more than a voxel), 1 (a ray per texel, as in
-                           the paper), 2 or 3; README "Colored stochastic shadow map" */
+                           the paper), 2 or 3; docs/techniques.md, CSSM */
 } umbra_cssm_desc;
 
 #endif

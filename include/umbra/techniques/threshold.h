@@ -4,7 +4,7 @@
  * texel, map_size^2 * 4 bytes: where the accumulated light opacity first passes the threshold.
  * Grey and binary: everything behind that depth is black in every channel, even where coloured
  * transmission lets light through, so in coloured scenes where light passes coloured material it
- * can be worse than no shadows (README, "Opacity-threshold shadow map"). */
+ * can be worse than no shadows (docs/techniques.md, "Opacity-threshold shadow map"). */
 #ifndef UMBRA_TECHNIQUES_THRESHOLD_H
 #define UMBRA_TECHNIQUES_THRESHOLD_H
 
