@@ -145,7 +145,7 @@ enum {
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_ORTHO, OPT_LIGHT_DIR, OPT_LIGHT_POS,
     OPT_LIGHT_COLOR, OPT_AMBIENT, OPT_STEP, OPT_SHADING, OPT_NO_SHADING, OPT_GROUND,
     OPT_NO_GROUND, OPT_COLORED, OPT_GREY, OPT_BACKGROUND, OPT_JITTER, OPT_SEED, OPT_PREINTEGRATED,
-    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS,
+    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION,
     OPT_PARAM = 1024 /* + the index of a technique option */
 };
 
@@ -205,6 +205,9 @@ static const fixed_option fixed[] = {
     {"seed", OPT_SEED, "N", "seed for the jitter and the stochastic maps (cssm's seed)"},
     {"preintegrated", OPT_PREINTEGRATED, NULL, "pre-integrated segments: the view ray's, and the "
                                                "convolution technique's light"},
+    {"interaction", OPT_INTERACTION, "MODE", "off (default) or auto: a frame after a light or "
+                                             "transfer-function change uses the technique's "
+                                             "draft, the next unchanged one the full map"},
     {"device", OPT_DEVICE, "SPEC", "OpenCL device: P:D indices or a name substring"},
     {"progress", OPT_PROGRESS, NULL, "progress line on stderr (default: when it is a terminal; "
                                      "--no-progress: never)"},
@@ -670,6 +673,14 @@ int parse_args(int argc, char **argv, options *o)
         case OPT_GREY: o->colored = 0; break;
         case OPT_JITTER: o->jitter = 1; break;
         case OPT_PREINTEGRATED: o->preintegrated = 1; break;
+        case OPT_INTERACTION:
+            if (strcmp(v, "off") == 0)
+                o->interaction = UMBRA_INTERACTION_OFF;
+            else if (strcmp(v, "auto") == 0)
+                o->interaction = UMBRA_INTERACTION_AUTO;
+            else
+                FAIL("--interaction '%s' is neither off nor auto", v);
+            break;
         case OPT_SEED:
             if (!parse_uint(v, &o->seed))
                 FAIL("--seed '%s' is not a whole number", v);
