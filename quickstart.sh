@@ -9,8 +9,9 @@ build=${1:-build}
 
 packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-headers opencl-c-headers
           pocl-opencl-icd libteem-dev libopenimageio-dev libnifti2-dev libcjson-dev
-          libcmocka-dev gnuplot-nox python3-dev python3-venv python3-numpy python3-pytest
-          python3-nibabel python3-pil)
+          libtiff-dev libexpat1-dev libcmocka-dev gnuplot-nox python3-dev python3-venv
+          python3-numpy python3-pytest python3-nibabel python3-pil python3-pydicom
+          libglfw3-dev libimgui-dev xvfb xauth libgl1-mesa-dri)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -7,7 +7,8 @@
  * malformed, an output path that cannot be written (checked before rendering), a request the
  * technique cannot do; 2 on a failure of the device or of memory (no device, an OpenCL error, out
  * of memory), or when writing the image fails after the render; 130 when interrupted (Ctrl-C
- * stops the render between two pieces of device work). */
+ * stops the render between two pieces of device work). The scene set up from the command line
+ * (session_begin) is shared with umbra-view (umbra_render.h). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <signal.h>
@@ -23,7 +24,7 @@
 /* Exit status for a failed library call, as the README states: 1 for bad input (an argument out
  * of range, a file that cannot be read or is malformed, a request the technique cannot do), 2 for
  * a failure of the device or of memory. */
-static int exit_status(umbra_status st)
+int exit_status(umbra_status st)
 {
     switch (st) {
     case UMBRA_SUCCESS: return 0;
@@ -35,12 +36,12 @@ static int exit_status(umbra_status st)
     }
 }
 
+/* user: the program's name. */
 static void on_error(void *user, umbra_status st, const char *msg)
 {
-    (void)user;
     if (st == UMBRA_ERROR_CANCELLED)
         return; /* reported as "interrupted" */
-    fprintf(stderr, "umbra-render: %s: %s\n", umbra_status_to_string(st), msg);
+    fprintf(stderr, "%s: %s: %s\n", (const char *)user, umbra_status_to_string(st), msg);
 }
 
 /* Ctrl-C sets the flag; the progress callback, called between pieces of device work, reads it
@@ -77,17 +78,7 @@ static int on_progress(void *user, float fraction)
     return interrupted != 0;
 }
 
-/* Everything the render needs; released in one place. */
-typedef struct session {
-    umbra_context ctx;
-    umbra_scene scene;
-    umbra_volume volume;
-    umbra_transfer_function tf, light_tf;
-    umbra_renderer renderer;
-    float *pixels;
-} session;
-
-static void session_end(session *s)
+void session_end(session *s)
 {
     free(s->pixels);
     umbra_renderer_release(s->renderer);
@@ -113,7 +104,7 @@ static umbra_status load_tf(umbra_context ctx, const char *path, const char *pre
     return umbra_transfer_function_load(ctx, path, out);
 }
 
-static int run(const options *o, session *s)
+int session_begin(const options *o, session *s)
 {
     umbra_context_desc cd;
     umbra_context_desc_init(&cd);
@@ -121,6 +112,7 @@ static int run(const options *o, session *s)
     cd.platform_index = o->platform_index;
     cd.device_index = o->device_index;
     cd.error_callback = on_error;
+    cd.error_user = (void *)o->program; /* only read: a string with the program's life */
     umbra_status st = umbra_context_create(&cd, &s->ctx);
     if (st != UMBRA_SUCCESS)
         return exit_status(st);
@@ -240,6 +232,24 @@ static int run(const options *o, session *s)
         (st = umbra_renderer_set_options(r, &rd)) ||
         (st = umbra_renderer_set_shadow(r, &o->shadow)))
         return exit_status(st);
+    s->view_volume = vol;
+    s->view_tf = tf;
+    s->camera = cam;
+    s->light = light;
+    s->options = rd;
+    s->shadow = o->shadow;
+    s->width = o->width;
+    s->height = o->height;
+    s->out = o->out;
+    return 0;
+}
+
+static int run(const options *o, session *s)
+{
+    int rc = session_begin(o, s);
+    if (rc)
+        return rc;
+    umbra_renderer r = s->renderer;
     s->pixels = malloc((size_t)o->width * o->height * 4 * sizeof(float));
     if (!s->pixels) {
         fprintf(stderr, "umbra-render: out of memory for a %ux%u image\n", o->width, o->height);
@@ -283,7 +293,7 @@ static int run(const options *o, session *s)
     return 0;
 }
 
-int main(int argc, char **argv)
+int umbra_render_main(int argc, char **argv)
 {
     options o;
     if (parse_args(argc, argv, &o) != 0)
@@ -294,3 +304,10 @@ int main(int argc, char **argv)
     session_end(&s);
     return rc;
 }
+
+#ifndef UMBRA_RENDER_NO_MAIN
+int main(int argc, char **argv)
+{
+    return umbra_render_main(argc, argv);
+}
+#endif

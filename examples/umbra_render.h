@@ -1,14 +1,23 @@
 // SPDX-License-Identifier: Apache-2.0
-/* examples/umbra_render.h: umbra-render's command line (examples/umbra_render_args.c), read by
- * the program itself (examples/umbra_render.c). */
+/* examples/umbra_render.h: umbra-render's command line (examples/umbra_render_args.c) and the
+ * scene it sets up from it (session_begin, examples/umbra_render.c), read by the program itself
+ * and by umbra-view (tools/umbra_view/), which takes every umbra-render option through the same
+ * parser, adds its own options to the same table, and opens every input the same way. umbra-view
+ * compiles umbra_render.c a second time with UMBRA_RENDER_NO_MAIN. */
 #ifndef UMBRA_RENDER_H
 #define UMBRA_RENDER_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "umbra/io.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct options {
+    const char *program; /* the name messages start with: "umbra-render", or the program's */
     const char *scene, *volume, *raw, *tf, *tf_preset, *light_tf, *out, *device;
     int platform_index, device_index; /* -1: not given */
     uint32_t scene_size, width, height;
@@ -23,6 +32,7 @@ typedef struct options {
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
     int preintegrated;
     umbra_interaction interaction;                                  /* --interaction */
+    int have_interaction;                                           /* --interaction given */
     int progress;                                                   /* -1: when a terminal */
     uint32_t seed;
     umbra_shadow_desc shadow; /* the technique and every parameter given (registry keys) */
@@ -34,4 +44,70 @@ typedef struct options {
  * input). --help and --version print and exit(0). */
 int parse_args(int argc, char **argv, options *o);
 
+/* A program that takes umbra-render's options and options of its own (umbra-view). */
+typedef struct program_option {
+    const char *name; /* the long option, without "--" */
+    const char *arg;  /* the value's shape in --help ("N"), NULL for a flag */
+    const char *help;
+} program_option;
+
+typedef struct program {
+    const char *name;  /* what messages, --help's usage line and --version say */
+    const char *about; /* a paragraph under --help's usage line, or NULL */
+    const program_option *options; /* listed first in --help */
+    size_t option_count;           /* at most 16 */
+    /* Called for each of the program's options in the order given, with its index in options
+     * and its value (NULL for a flag); returns 0, or prints what is wrong and returns 1. */
+    int (*take)(void *user, size_t index, const char *value);
+    void *user;
+} program;
+
+/* parse_args for program p: its options join umbra-render's in the one getopt_long table (so
+ * --opt=value and unambiguous prefixes work for both, and a prefix of two is refused), and
+ * messages, --help and --version name p->name. */
+int parse_args_as(const program *p, int argc, char **argv, options *o);
+
+/* A technique parameter (umbra/registry.h) as --help describes it: "doc, in unit (default D;
+ * range or allowed values, or 0: what 0 means)", into text (size bytes, truncated). */
+void param_describe(const umbra_param_info *p, char *text, size_t size);
+/* The option that sets parameter p to value, as parse_args reads it: "--map-size auto",
+ * "--no-lookup-table", "--map-step 0.5" (floats with 9 digits: the value exactly). */
+void param_option_text(const umbra_param_info *p, double value, char *text, size_t size);
+
+/* Everything a render needs; released in one place (session_end). */
+typedef struct session {
+    umbra_context ctx;
+    umbra_scene scene;
+    umbra_volume volume;
+    umbra_transfer_function tf, light_tf;
+    umbra_renderer renderer;
+    float *pixels;
+    /* As set on the renderer by session_begin: */
+    umbra_volume view_volume;        /* borrowed: volume or scene.volume */
+    umbra_transfer_function view_tf; /* borrowed: tf or scene.tf */
+    umbra_camera camera;
+    umbra_light light;
+    umbra_render_desc options;
+    umbra_shadow_desc shadow;
+    uint32_t width, height;          /* --size */
+    const char *out;                 /* --out, checked to be a writable .png or .exr path */
+} session;
+
+/* Sets up s from o: context (its errors printed as "<o->program>: ..."), volume or scene,
+ * transfer functions, camera, light, options and shadow technique, on a renderer ready to
+ * render. Returns 0 or umbra-render's exit status (the message is on stderr). s must be zeroed
+ * first and is released with session_end either way. */
+int session_begin(const options *o, session *s);
+void session_end(session *s);
+
+/* umbra-render's exit status for a failed library call: 1 bad input, 2 device or memory. */
+int exit_status(umbra_status st);
+
+/* umbra-render's program: what its main does (compiled with UMBRA_RENDER_NO_MAIN,
+ * umbra_render.c leaves main out and keeps this). */
+int umbra_render_main(int argc, char **argv);
+
+#ifdef __cplusplus
+}
+#endif
 #endif

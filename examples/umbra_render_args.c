@@ -7,7 +7,8 @@
  * technique is known, through umbra_shadow_desc_set_param, which checks their ranges; --help
  * lists them from the same description. Numbers are parsed strictly (whole numbers: decimal
  * digits only, no sign, no trailing text). --opt=value, -o FILE, -s WxH, -t NAME and unambiguous
- * prefixes of long options are accepted. */
+ * prefixes of long options are accepted. Another program (umbra-view) adds its own options to the
+ * same table with parse_args_as; messages, --help and --version then carry its name. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <getopt.h>
@@ -20,6 +21,9 @@
 #include <unistd.h>
 
 #include "umbra_render.h"
+
+/* The program being parsed for: messages start with its name (set by parse_args_as). */
+static const char *program_name = "umbra-render";
 
 static int parse_floats(const char *s, float *out, int n)
 {
@@ -97,7 +101,8 @@ static int check_output(const char *path)
     struct stat sb;
     path_extension(path, ext, sizeof ext);
     if (strcmp(ext, "png") != 0 && strcmp(ext, "exr") != 0) {
-        fprintf(stderr, "umbra-render: --out '%s': the extension must be .png or .exr\n", path);
+        fprintf(stderr, "%s: --out '%s': the extension must be .png or .exr\n", program_name,
+                path);
         return 1;
     }
     const char *slash = strrchr(path, '/');
@@ -109,22 +114,22 @@ static int check_output(const char *path)
         memcpy(dir, path, (size_t)(slash - path));
         dir[slash - path] = '\0';
     } else {
-        fprintf(stderr, "umbra-render: --out: the directory name is longer than %zu bytes\n",
-                sizeof dir - 1);
+        fprintf(stderr, "%s: --out: the directory name is longer than %zu bytes\n",
+                program_name, sizeof dir - 1);
         return 1;
     }
     if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
-        fprintf(stderr, "umbra-render: --out '%s': the directory '%s' does not exist\n", path,
-                dir);
+        fprintf(stderr, "%s: --out '%s': the directory '%s' does not exist\n",
+                program_name, path, dir);
         return 1;
     }
     if (access(dir, W_OK | X_OK) != 0) {
-        fprintf(stderr, "umbra-render: --out '%s': the directory '%s' is not writable\n", path,
-                dir);
+        fprintf(stderr, "%s: --out '%s': the directory '%s' is not writable\n",
+                program_name, path, dir);
         return 1;
     }
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
-        fprintf(stderr, "umbra-render: --out '%s' is a directory\n", path);
+        fprintf(stderr, "%s: --out '%s' is a directory\n", program_name, path);
         return 1;
     }
     return 0;
@@ -132,7 +137,8 @@ static int check_output(const char *path)
 
 #define BAD(...)                                                                               \
     do {                                                                                       \
-        fprintf(stderr, "umbra-render: " __VA_ARGS__);                                         \
+        fprintf(stderr, "%s: ", program_name);                                                 \
+        fprintf(stderr, __VA_ARGS__);                                                          \
         fputc('\n', stderr);                                                                   \
         return 1;                                                                              \
     } while (0)
@@ -146,8 +152,10 @@ enum {
     OPT_LIGHT_COLOR, OPT_AMBIENT, OPT_STEP, OPT_SHADING, OPT_NO_SHADING, OPT_GROUND,
     OPT_NO_GROUND, OPT_COLORED, OPT_GREY, OPT_BACKGROUND, OPT_JITTER, OPT_SEED, OPT_PREINTEGRATED,
     OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION,
-    OPT_PARAM = 1024 /* + the index of a technique option */
+    OPT_PARAM = 1024,  /* + the index of a technique option */
+    OPT_PROGRAM = 2048 /* + the index of an option of the program's own (parse_args_as) */
 };
+#define MAX_PROGRAM_OPTIONS 16
 
 typedef struct fixed_option {
     const char *name;
@@ -162,7 +170,9 @@ static const fixed_option fixed[] = {
     {"scene", OPT_SCENE, "NAME", "built-in scene: spheres (default), slab, marschner-lobb"},
     {"scene-size", OPT_SCENE_SIZE, "N", "built-in scene resolution N^3 (default per scene)"},
     {"volume", OPT_VOLUME, "FILE", "volume file: .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI), "
-                                   ".mha/.mhd (MetaImage), .dat (Voreen)"},
+                                   ".mha/.mhd (MetaImage), .dat (Voreen), .dcm or a DICOM "
+                                   "series directory, .tif/.tiff (a stack, OME-TIFF too) or a "
+                                   "directory of them"},
     {"allow-data-root", OPT_DATA_ROOT, "DIR", "a header's detached data file may also lie under "
                                               "DIR (repeatable; by default only in the header's "
                                               "own directory)"},
@@ -320,18 +330,19 @@ static const char *num(double v, char buf[40])
     return buf;
 }
 
-/* A parameter's value shape and what it accepts: "auto|N", "1|7|13|21"; default and range. */
-static void param_help(FILE *f, const umbra_param_info *p)
+/* A key as an option's name: '_' written '-' ("map_size" -> "map-size"). */
+static void key_option(const char *key, char *opt, size_t n)
 {
-    char left[160], text[1024], range[256] = "", def[40];
-    const char *shape = p->type == UMBRA_PARAM_FLOAT ? "X" : "N";
-    char opt[64];
-    snprintf(opt, sizeof opt, "%s", p->key);
+    snprintf(opt, n, "%s", key);
     for (char *c = opt; *c; ++c)
         if (*c == '_')
             *c = '-';
+}
+
+void param_describe(const umbra_param_info *p, char *text, size_t size)
+{
+    char range[256] = "", def[40];
     if (p->type == UMBRA_PARAM_BOOL) {
-        snprintf(left, sizeof left, "    --%s | --no-%s", opt, opt);
         snprintf(range, sizeof range, "on or off");
     } else {
         size_t n = 0;
@@ -348,15 +359,6 @@ static void param_help(FILE *f, const umbra_param_info *p)
         }
         if (p->flags & UMBRA_PARAM_ZERO)
             snprintf(range + n, sizeof range - n, ", or 0: %s", p->zero_doc);
-        snprintf(left, sizeof left, "    --%s %s%s%s", opt, p->zero_name ? p->zero_name : "",
-                 p->zero_name ? "|" : "", shape);
-    }
-    if (p->alias) {
-        size_t n = strlen(left);
-        snprintf(left + n, sizeof left - n, " (--%s)", p->alias);
-        for (char *c = left + n; *c; ++c)
-            if (*c == '_')
-                *c = '-';
     }
     if (p->type == UMBRA_PARAM_BOOL)
         snprintf(def, sizeof def, "%s", p->default_value != 0.0 ? "on" : "off");
@@ -364,8 +366,43 @@ static void param_help(FILE *f, const umbra_param_info *p)
         snprintf(def, sizeof def, "%s", p->zero_name);
     else
         num(p->default_value, def);
-    snprintf(text, sizeof text, "%s%s%s (default %s; %s)", p->doc, p->unit ? ", in " : "",
+    snprintf(text, size, "%s%s%s (default %s; %s)", p->doc, p->unit ? ", in " : "",
              p->unit ? p->unit : "", def, range);
+}
+
+void param_option_text(const umbra_param_info *p, double value, char *text, size_t size)
+{
+    char opt[64];
+    key_option(p->key, opt, sizeof opt);
+    if (p->type == UMBRA_PARAM_BOOL)
+        snprintf(text, size, "--%s%s", value != 0.0 ? "" : "no-", opt);
+    else if (p->zero_name && value == 0.0)
+        snprintf(text, size, "--%s %s", opt, p->zero_name);
+    else
+        snprintf(text, size, p->type == UMBRA_PARAM_FLOAT ? "--%s %.9g" : "--%s %.0f", opt, value);
+}
+
+/* A parameter's lines in --help: its options, the value's shape and what it accepts
+ * ("auto|N", "1|7|13|21"), then param_describe's text. */
+static void param_help(FILE *f, const umbra_param_info *p)
+{
+    char left[160], text[1024];
+    const char *shape = p->type == UMBRA_PARAM_FLOAT ? "X" : "N";
+    char opt[64];
+    key_option(p->key, opt, sizeof opt);
+    if (p->type == UMBRA_PARAM_BOOL)
+        snprintf(left, sizeof left, "    --%s | --no-%s", opt, opt);
+    else
+        snprintf(left, sizeof left, "    --%s %s%s%s", opt, p->zero_name ? p->zero_name : "",
+                 p->zero_name ? "|" : "", shape);
+    if (p->alias) {
+        size_t n = strlen(left);
+        snprintf(left + n, sizeof left - n, " (--%s)", p->alias);
+        for (char *c = left + n; *c; ++c)
+            if (*c == '_')
+                *c = '-';
+    }
+    param_describe(p, text, sizeof text);
     fprintf(f, "%s", left);
     int col = (int)strlen(left);
     if (col >= 33) {
@@ -375,25 +412,35 @@ static void param_help(FILE *f, const umbra_param_info *p)
     wrap(f, text, col, 34);
 }
 
-static void usage(FILE *f)
+/* One option's line(s) in --help: its short form if val is a letter, its value's shape (arg,
+ * NULL for a flag) and its help wrapped from column 34. */
+static void option_help(FILE *f, int val, const char *name, const char *arg, const char *help)
 {
-    fprintf(f, "usage: umbra-render [options]\n");
-    for (size_t i = 0; i < FIXED_COUNT; ++i) {
-        if (!fixed[i].help)
-            continue;
-        char left[96];
-        int n = fixed[i].val < 256
-                    ? snprintf(left, sizeof left, "  -%c, --%s%s%s", fixed[i].val, fixed[i].name,
-                               fixed[i].arg ? " " : "", fixed[i].arg ? fixed[i].arg : "")
-                    : snprintf(left, sizeof left, "      --%s%s%s", fixed[i].name,
-                               fixed[i].arg ? " " : "", fixed[i].arg ? fixed[i].arg : "");
-        fprintf(f, "%s", left);
-        if (n >= 33) {
-            fputc('\n', f);
-            n = 0;
-        }
-        wrap(f, fixed[i].help, n, 34);
+    char left[96];
+    int n = val < 256 ? snprintf(left, sizeof left, "  -%c, --%s%s%s", val, name,
+                                 arg ? " " : "", arg ? arg : "")
+                      : snprintf(left, sizeof left, "      --%s%s%s", name, arg ? " " : "",
+                                 arg ? arg : "");
+    fprintf(f, "%s", left);
+    if (n >= 33) {
+        fputc('\n', f);
+        n = 0;
     }
+    wrap(f, help, n, 34);
+}
+
+/* prog: the program whose own options come first (NULL: umbra-render alone). */
+static void usage(FILE *f, const program *prog)
+{
+    fprintf(f, "usage: %s [options]\n", program_name);
+    if (prog && prog->about)
+        wrap(f, prog->about, 0, 2);
+    for (size_t i = 0; prog && i < prog->option_count; ++i)
+        option_help(f, 256, prog->options[i].name, prog->options[i].arg,
+                    prog->options[i].help);
+    for (size_t i = 0; i < FIXED_COUNT; ++i)
+        if (fixed[i].help)
+            option_help(f, fixed[i].val, fixed[i].name, fixed[i].arg, fixed[i].help);
     fprintf(f, "\nShadow techniques (--technique NAME) and their parameters:\n");
     char maps[256] = "";
     for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
@@ -475,7 +522,14 @@ static int apply_param(options *o, const given *g)
 
 int parse_args(int argc, char **argv, options *o)
 {
+    return parse_args_as(NULL, argc, argv, o);
+}
+
+int parse_args_as(const program *p, int argc, char **argv, options *o)
+{
     memset(o, 0, sizeof *o);
+    program_name = p ? p->name : "umbra-render";
+    o->program = program_name;
     o->scene = "spheres";
     o->out = "umbra.png";
     o->width = o->height = 512;
@@ -486,8 +540,21 @@ int parse_args(int argc, char **argv, options *o)
     umbra_shadow_desc_init(&o->shadow);
     make_param_options();
 
-    struct option longopts[FIXED_COUNT + MAX_PARAM_OPTIONS + 1];
+    struct option longopts[FIXED_COUNT + MAX_PARAM_OPTIONS + MAX_PROGRAM_OPTIONS + 1];
     size_t n = 0;
+    size_t own = p ? p->option_count : 0;
+    if (own > MAX_PROGRAM_OPTIONS)
+        BAD("%zu options of its own, at most %d", own, MAX_PROGRAM_OPTIONS);
+    for (size_t i = 0; i < own; ++i) {
+        int taken = fixed_named(p->options[i].name);
+        for (int k = 0; k < param_option_count; ++k)
+            taken |= strcmp(param_options[k].name, p->options[i].name) == 0;
+        if (taken)
+            BAD("--%s is umbra-render's option too", p->options[i].name);
+        longopts[n++] = (struct option){p->options[i].name,
+                                        p->options[i].arg ? required_argument : no_argument,
+                                        NULL, OPT_PROGRAM + (int)i};
+    }
     for (size_t i = 0; i < FIXED_COUNT; ++i)
         longopts[n++] = (struct option){fixed[i].name,
                                         fixed[i].arg ? required_argument : no_argument, NULL,
@@ -514,7 +581,8 @@ int parse_args(int argc, char **argv, options *o)
         const char *v = optarg;
 #define FAIL(...)                                                                              \
     do {                                                                                       \
-        fprintf(stderr, "umbra-render: " __VA_ARGS__);                                         \
+        fprintf(stderr, "%s: ", program_name);                                                 \
+        fprintf(stderr, __VA_ARGS__);                                                          \
         fputc('\n', stderr);                                                                   \
         goto done;                                                                             \
     } while (0)
@@ -542,11 +610,11 @@ int parse_args(int argc, char **argv, options *o)
         case ':':
             FAIL("%s needs a value", argv[optind - 1]);
         case 'h':
-            usage(stdout);
+            usage(stdout, p);
             free(givens);
             exit(0);
         case OPT_VERSION:
-            printf("umbra-render %s (library %s)\n", UMBRA_VERSION_STRING, umbra_version());
+            printf("%s %s (library %s)\n", program_name, UMBRA_VERSION_STRING, umbra_version());
             free(givens);
             exit(0);
         case OPT_SCENE: o->scene = v; break;
@@ -674,6 +742,7 @@ int parse_args(int argc, char **argv, options *o)
         case OPT_JITTER: o->jitter = 1; break;
         case OPT_PREINTEGRATED: o->preintegrated = 1; break;
         case OPT_INTERACTION:
+            o->have_interaction = 1;
             if (strcmp(v, "off") == 0)
                 o->interaction = UMBRA_INTERACTION_OFF;
             else if (strcmp(v, "auto") == 0)
@@ -704,16 +773,20 @@ int parse_args(int argc, char **argv, options *o)
         }
         case OPT_PROGRESS: o->progress = 1; break;
         case OPT_NO_PROGRESS: o->progress = 0; break;
-        default: {
-            const param_option *p = &param_options[c - OPT_PARAM];
-            givens[ngiven++] = (given){p->key, p->name, v, (double)p->value};
+        default:
+            if (c >= OPT_PROGRAM) {
+                if (p->take(p->user, (size_t)(c - OPT_PROGRAM), v) != 0)
+                    goto done;
+            } else {
+                const param_option *po = &param_options[c - OPT_PARAM];
+                givens[ngiven++] = (given){po->key, po->name, v, (double)po->value};
+            }
             break;
-        }
         }
 #undef FAIL
     }
     if (optind < argc) {
-        fprintf(stderr, "umbra-render: unexpected argument '%s' (see --help)\n", argv[optind]);
+        fprintf(stderr, "%s: unexpected argument '%s' (see --help)\n", program_name, argv[optind]);
         goto done;
     }
     /* In the order given, now that the technique is known: a later value wins. */
@@ -721,11 +794,11 @@ int parse_args(int argc, char **argv, options *o)
         if (apply_param(o, &givens[i]) != 0)
             goto done;
     if (o->raw && (!o->have_raw_dims || !o->have_raw_type)) {
-        fprintf(stderr, "umbra-render: --raw needs --raw-dims and --raw-type\n");
+        fprintf(stderr, "%s: --raw needs --raw-dims and --raw-type\n", program_name);
         goto done;
     }
     if (o->have_light_dir && o->have_light_pos) {
-        fprintf(stderr, "umbra-render: --light-dir and --light-pos exclude each other\n");
+        fprintf(stderr, "%s: --light-dir and --light-pos exclude each other\n", program_name);
         goto done;
     }
     rc = check_output(o->out);

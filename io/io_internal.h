@@ -104,6 +104,30 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out);
 
+/* io/tiff.c and io/dicom.cpp: the stack readers behind umbra_volume_load_tiff and
+ * umbra_volume_load_dicom, on count files (count 1: one file; never a directory, io/series.c
+ * lists those). func names the public function in messages. */
+umbra_status umbra__volume_load_tiff(umbra_context ctx, const char *func, const char *const *paths,
+                                     size_t count, umbra_volume *out);
+umbra_status umbra__volume_load_dicom(umbra_context ctx, const char *func,
+                                      const char *const *paths, size_t count, umbra_volume *out);
+
+/* io/series.c: a directory as a TIFF stack (when it holds .tif / .tiff files) or a DICOM series;
+ * and whether a file name is a TIFF's. */
+umbra_status umbra__volume_load_directory(umbra_context ctx, const char *func, const char *dir,
+                                          umbra_volume *out);
+int umbra__is_tiff_name(const char *name);
+
+/* io/paraview.c: nonzero if the ParaView preset file path holds a preset named name (nothing is
+ * recorded anywhere: a file that is not a preset file just holds none). */
+int umbra__paraview_file_holds(const char *path, const char *name);
+
+/* io/paraview_search.c: the first file of the preset search path (see there) holding a preset
+ * named name, in a malloc'ed *found. Else UMBRA_ERROR_IO naming the directories searched; with
+ * also_file the message says name was not a file either. */
+umbra_status umbra__paraview_find(umbra_context ctx, const char *func, const char *name,
+                                  int also_file, char **found);
+
 #ifdef __cplusplus
 }
 #endif

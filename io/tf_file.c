@@ -12,7 +12,9 @@
  * Blank lines are ignored; at least one point is required and at most 65536 are allowed
  * (UMBRA_TF_MAX_POINTS); the table build is linear in points + resolution. The table is built by
  * umbra_transfer_function_create_from_points. Numbers are parsed in the "C" locale, so a decimal
- * point is a '.' whatever locale the application has set. */
+ * point is a '.' whatever locale the application has set. A path ending in .json is a ParaView
+ * preset (io/paraview.c); a bare name (no '/') that is no file is a preset's name, looked up in
+ * the preset search path (io/paraview_search.c). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -21,6 +23,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io_internal.h"
 
@@ -102,6 +105,20 @@ umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
     }
     if (path && strlen(path) > 5 && strcmp(path + strlen(path) - 5, ".json") == 0) {
         return umbra_transfer_function_load_paraview(ctx, path, NULL, out, NULL);
+    }
+    if (path && path[0] != '\0' && !strchr(path, '/') && access(path, F_OK) != 0 &&
+        errno == ENOENT) {
+        /* A bare name that is no file: a preset's name, looked up in the preset search path. */
+        umbra_paraview_options po;
+        char *found = NULL;
+        umbra_paraview_options_init(&po);
+        po.preset = path;
+        st = umbra__paraview_find(ctx, __func__, path, 1, &found);
+        if (st == UMBRA_SUCCESS) {
+            st = umbra_transfer_function_load_paraview(ctx, found, &po, out, NULL);
+        }
+        free(found);
+        return st;
     }
     st = umbra__read_file(ctx, __func__, path, &buf, &size);
     if (st != UMBRA_SUCCESS) {

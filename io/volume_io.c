@@ -605,9 +605,26 @@ fail:
 
 /* ---- by extension ------------------------------------------------------------------------ */
 
+/* Nonzero if path starts with DICOM's 128-byte preamble and "DICM". */
+static int has_dicom_magic(const char *path)
+{
+    unsigned char head[132];
+    FILE *f = NULL;
+    size_t size = 0;
+    int yes = 0;
+    if (umbra__file_open(NULL, __func__, path, &f, &size) != UMBRA_SUCCESS) {
+        return 0;
+    }
+    yes = size >= sizeof head && fread(head, 1, sizeof head, f) == sizeof head &&
+          memcmp(head + 128, "DICM", 4) == 0;
+    fclose(f);
+    return yes;
+}
+
 umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out)
 {
     const char *ext;
+    struct stat sb;
     if (!out) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
     }
@@ -630,9 +647,22 @@ umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume
     if (equal_nocase(ext, strlen(ext), "mha") || equal_nocase(ext, strlen(ext), "mhd")) {
         return umbra_volume_load_metaimage(ctx, path, out);
     }
+    /* After the single-file formats, which refuse a directory by name as not a regular file. */
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        return umbra__volume_load_directory(ctx, __func__, path, out);
+    }
+    if (umbra__is_tiff_name(path)) {
+        return umbra_volume_load_tiff(ctx, &path, 1, out);
+    }
+    if (equal_nocase(ext, strlen(ext), "dcm") || equal_nocase(ext, strlen(ext), "dicom") ||
+        equal_nocase(ext, strlen(ext), "ima") || has_dicom_magic(path)) {
+        return umbra_volume_load_dicom(ctx, &path, 1, out);
+    }
     return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                        "%s: \"%s\": unknown extension; supported are .nrrd, .nhdr (NRRD), .nii, "
-                       ".nii.gz (NIfTI), .mha, .mhd (MetaImage) and .dat (Voreen); VTK (.vti) is "
-                       "not supported; load headerless raw files with umbra_volume_load_raw",
+                       ".nii.gz (NIfTI), .mha, .mhd (MetaImage), .dat (Voreen), .tif, .tiff (TIFF "
+                       "stacks), .dcm or a file starting with DICOM's preamble, and a directory "
+                       "(a DICOM series or TIFF stack); VTK (.vti) is not supported; load "
+                       "headerless raw files with umbra_volume_load_raw",
                        __func__, path);
 }

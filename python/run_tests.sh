@@ -5,7 +5,7 @@
 # Builds and installs python/ with pip into a virtual environment in BUILD_DIR (Debian's pip
 # refuses system installs, PEP 668) and runs its pytest suite, which compares against
 # BUILD_DIR/umbra-render's pixels. The Debian packages it needs (python3-dev, -venv, -numpy,
-# -pytest, -nibabel, -pil) are in quickstart.sh's list; pip fetches scikit-build-core and nanobind.
+# -pytest, -nibabel, -pil, -pydicom) are in quickstart.sh's list; pip fetches scikit-build-core and nanobind.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=$(cd "${1:-build}" && pwd)

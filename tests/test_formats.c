@@ -200,7 +200,7 @@ static void test_paraview_midpoint_and_sharpness(void **state)
     umbra_transfer_function_release(tf);
 }
 
-/* Without Points the opacity is ParaView's default ramp over the preset's range. */
+/* Without Points the opacity is umbra's default ramp over the preset's range: 0 to 0.1. */
 static void test_paraview_default_opacity_ramp(void **state)
 {
     umbra_context ctx = *state;
@@ -211,8 +211,8 @@ static void test_paraview_default_opacity_ramp(void **state)
                      UMBRA_SUCCESS);
     t = umbra_transfer_function_data(tf);
     assert_float_equal(t[3], 0.0, 1e-6);
-    assert_float_equal(t[4 * 3 + 3], 0.3, 1e-6);
-    assert_float_equal(t[4 * 10 + 3], 1.0, 1e-6);
+    assert_float_equal(t[4 * 3 + 3], 0.03, 1e-6);
+    assert_float_equal(t[4 * 10 + 3], UMBRA_PARAVIEW_DEFAULT_OPACITY, 1e-6);
     umbra_transfer_function_release(tf);
 }
 
@@ -331,9 +331,9 @@ static void test_paraview_bad_presets_named(void **state)
         {"[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1, 1]}] trailing", UMBRA_ERROR_FORMAT,
          "malformed JSON", NULL},
         {"[{\"Name\": \"x\", \"Points\": [0, 0, 0.5, 0, 1, 1, 0.5, 0]}]", UMBRA_ERROR_FORMAT,
-         "has no RGBPoints", "\"x\""},
-        {"[{\"Name\": \"cat\", \"IndexedColors\": [1, 0, 0]}]", UMBRA_ERROR_FORMAT,
-         "has no RGBPoints", "IndexedColors"},
+         "has neither RGBPoints nor IndexedColors", "\"x\""},
+        {"[{\"Name\": \"cat\", \"IndexedColors\": [1, 0]}]", UMBRA_ERROR_FORMAT,
+         "IndexedColors has 2 numbers", "multiple of 3"},
         {"[{\"RGBPoints\": [0, 0, 0, 0, 2, 1, 1, 1, 1, 0, 0, 0]}]", UMBRA_ERROR_FORMAT,
          "point 2 has x = 1 below point 1's 2", "ascend"},
         {"[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1, 1], \"Points\": [1, 0, 0.5, 0, 0, 1, 0.5, 0]}]",
@@ -363,8 +363,8 @@ static void test_paraview_bad_presets_named(void **state)
         {"[{\"RGBPoints\": [-1e308, 1, 1, 1, 1e308, 1, 1, 1]}]", UMBRA_ERROR_FORMAT,
          "finite distance apart", NULL},
         {"[{\"RGBPoints\": [3, 1, 1, 1]}]", UMBRA_ERROR_FORMAT, "span [3, 3]", NULL},
-        {"[{\"ColorSpace\": \"HSV\", \"RGBPoints\": [0, 1, 1, 1, 1, 1, 1, 1]}]",
-         UMBRA_ERROR_UNSUPPORTED, "ColorSpace \"HSV\" is not supported", NULL},
+        {"[{\"ColorSpace\": \"HSL\", \"RGBPoints\": [0, 1, 1, 1, 1, 1, 1, 1]}]",
+         UMBRA_ERROR_UNSUPPORTED, "ColorSpace \"HSL\" is not supported", NULL},
         {"[{\"ColorSpace\": \"Lab/CIEDE2000\", \"RGBPoints\": [0, 1, 1, 1, 1, 1, 1, 1]}]",
          UMBRA_ERROR_UNSUPPORTED, "\"Lab/CIEDE2000\"", NULL},
     };

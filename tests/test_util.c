@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 umbra_context test_context(void)
 {
@@ -242,4 +243,31 @@ umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float al
     umbra_transfer_function tf = NULL;
     assert_int_equal(umbra_transfer_function_create(ctx, rgba, 2, &tf), UMBRA_SUCCESS);
     return tf;
+}
+
+void test_cli_renders_with_named_preset(umbra_context ctx, const char *volume,
+                                        const char *out_name)
+{
+    const char *exe = getenv("UMBRA_RENDER") ? getenv("UMBRA_RENDER") : "./umbra-render";
+    char out[1024], cmd[4096];
+    uint32_t w = 0, h = 0;
+    float *rgba = NULL;
+    test_tmp_path(out, sizeof out, out_name);
+    assert_int_equal(access(exe, X_OK), 0);
+    snprintf(cmd, sizeof cmd,
+             "'%s' --volume '%s' --tf 'Cool to Warm' --technique cssm --size 48x48 --no-ground "
+             "--out '%s' 2>/dev/null",
+             exe, volume, out);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(umbra_image_read(ctx, out, &w, &h, &rgba), UMBRA_SUCCESS);
+    assert_int_equal(w, 48);
+    {
+        const float *centre = rgba + 4 * (24 * 48 + 24), *corner = rgba;
+        print_message("centre %g %g %g, corner %g %g %g\n", (double)centre[0],
+                      (double)centre[1], (double)centre[2], (double)corner[0], (double)corner[1],
+                      (double)corner[2]);
+        assert_float_equal(corner[0], 0.08, 0.01);
+        assert_true(fabsf(centre[0] - corner[0]) + fabsf(centre[2] - corner[2]) > 0.05f);
+    }
+    free(rgba);
 }

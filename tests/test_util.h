@@ -86,4 +86,11 @@ umbra_volume test_volume_bricks(umbra_context ctx, uint32_t nx, uint32_t ny, uin
 /* A grey transfer function with constant alpha (per voxel) everywhere. */
 umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float alpha);
 
+/* Runs umbra-render (./umbra-render in ctest's working directory, or $UMBRA_RENDER) with
+ * --volume volume --tf "Cool to Warm" (an installed preset, by name) --technique cssm at 48x48
+ * into test_tmpdir()/out_name, and asserts exit 0, the default background in a corner and the
+ * lit volume (not the background) in the centre. */
+void test_cli_renders_with_named_preset(umbra_context ctx, const char *volume,
+                                        const char *out_name);
+
 #endif

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, MetaImage, Voreen .dat
- * and raw files, transfer functions from text files and ParaView JSON presets, images to and from PNG and
- * EXR.
+/* umbra/io.h: umbra_io, the optional file layer: volumes from NRRD, NIfTI-1/2, MetaImage, DICOM,
+ * TIFF stacks, Voreen .dat and raw files, transfer functions from text files and ParaView JSON
+ * presets, images to and from PNG and EXR.
  *
  * It is a library of its own (libumbra_io, CMake target umbra::io, pkg-config umbra-io) that links
- * Teem, OpenImageIO, nifticlib and cJSON, so that libumbra itself depends on OpenCL and the C
- * library only. It is built on libumbra's public API: whatever it loads an application could
- * also hand to umbra_volume_create or umbra_transfer_function_create itself. Errors are recorded
- * on the context like every umbra error. Readers open regular files only. */
+ * Teem, OpenImageIO, nifticlib, cJSON, libtiff and expat, so that libumbra itself depends
+ * on OpenCL and the C library only. It is built on libumbra's public API: whatever it loads an
+ * application could also hand to umbra_volume_create or umbra_transfer_function_create itself.
+ * Errors are recorded on the context like every umbra error. Readers open regular files only. */
 #ifndef UMBRA_IO_H
 #define UMBRA_IO_H
 
@@ -23,7 +23,9 @@ extern "C" {
 /* ---- volumes --------------------------------------------------------------------------------- */
 
 /* Loads a volume by file extension: .nrrd / .nhdr (Teem), .nii / .nii.gz (NIfTI), .mha / .mhd
- * (MetaImage), .dat (Voreen). */
+ * (MetaImage), .dat (Voreen), .tif / .tiff (umbra_volume_load_tiff), .dcm / .dicom / .ima or any
+ * file starting with DICOM's preamble (umbra_volume_load_dicom); a directory is a TIFF stack of
+ * its .tif / .tiff files when it holds any, else a DICOM series. */
 UMBRA_API umbra_status umbra_volume_load(umbra_context ctx, const char *path, umbra_volume *out);
 
 /* The data-file policy. A NRRD ("data file"), MetaImage (ElementDataFile) or Voreen .dat
@@ -110,6 +112,38 @@ UMBRA_API umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *pa
 UMBRA_API umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path,
                                                    umbra_volume *out);
 
+/* Loads a DICOM volume (Part 10 files, read by umbra itself: see the README): count files of one
+ * series in any order, one directory (its files, DICOMDIR and names starting with '.' passed
+ * over, subdirectories not entered), or one single-frame file. Greyscale, 8 or 16 bits
+ * allocated; implicit or explicit VR little endian, uncompressed or RLE Lossless (JPEG, JPEG-LS,
+ * JPEG 2000, multi-frame and big-endian files are UMBRA_ERROR_UNSUPPORTED). Slices are sorted by ImagePositionPatient along
+ * the slice normal and must be one series (SeriesInstanceUID), one size and pixel layout, one
+ * orientation, on one line along the normal (no gantry tilt) at uniform steps (each within 1% of a
+ * step of its place): the z spacing is that step, x and y PixelSpacing's column and row spacing.
+ * The volume carries DICOM's patient space (LPS, millimetres): origin the first slice's
+ * ImagePositionPatient, axes the row and column directions of ImageOrientationPatient and their
+ * normal. RescaleSlope/Intercept are applied per slice: without rescale the stored type is kept
+ * (int8 becomes int16); integer rescale gives int16 when the rescaled values fit (else float32);
+ * a fractional one float32. Anything else (a second series, another size, a missing or repeated
+ * position, uneven spacing, colour, truncated pixel data, compressed data claiming more than
+ * 1032 times its bytes) is UMBRA_ERROR_FORMAT or UMBRA_ERROR_UNSUPPORTED naming the file and
+ * value; at most 65536 files. */
+UMBRA_API umbra_status umbra_volume_load_dicom(umbra_context ctx, const char *const *paths,
+                                               size_t count, umbra_volume *out);
+
+/* Loads a TIFF stack through libtiff: one multi-page TIFF (each full-resolution page a z slice;
+ * pages marked reduced-resolution are passed over), count single-page TIFFs in the order given,
+ * or one directory (its .tif / .tiff files in natural name order: "2" before "10"). Greyscale
+ * pages, stripped or tiled, any compression libtiff decodes: 8- and 16-bit unsigned kept, int16
+ * kept, int8 becomes int16, 32-bit float kept; every slice the same size and type. OME-TIFF:
+ * PhysicalSizeX/Y/Z of its OME-XML (in the x axis's unit) are the spacing, and it must hold one
+ * image of one channel and time point; else the spacing is 1. The box is centred. A page that
+ * does not decode, slices of different sizes, colour or other sample types, more than 65536
+ * slices or slices claiming more than 1032 times their files' bytes are refused with
+ * UMBRA_ERROR_FORMAT or UMBRA_ERROR_UNSUPPORTED naming the file and page. */
+UMBRA_API umbra_status umbra_volume_load_tiff(umbra_context ctx, const char *const *paths,
+                                              size_t count, umbra_volume *out);
+
 typedef struct umbra_raw_desc {
     size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */
     umbra_scalar_type type;
@@ -136,32 +170,52 @@ UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path
  * values ascending (equal values make a step): in [0,1] of the volume's normalised range, or with
  * a range, data values in [LO, HI]. The file must be a regular file; errors are UMBRA_ERROR_IO or
  * UMBRA_ERROR_FORMAT naming path:line and the value. A path ending in .json is read
- * as a ParaView preset with umbra_transfer_function_load_paraview's defaults. */
+ * as a ParaView preset with umbra_transfer_function_load_paraview's defaults; a bare name (no
+ * '/') that is no file is a preset's name, looked up in the preset search path (as
+ * umbra_transfer_function_load_paraview with no path), e.g. "Cool to Warm". */
 UMBRA_API umbra_status umbra_transfer_function_load(umbra_context ctx, const char *path,
                                                     umbra_transfer_function *out);
+
+/* The opacity a ParaView preset without "Points" gets (ParaView's own presets carry none): a
+ * linear ramp from 0 at the preset's lowest x to this at its highest, or this for every category
+ * of a categorical preset. An opacity is per voxel, as in umbra's own format. */
+#define UMBRA_PARAVIEW_DEFAULT_OPACITY 0.1
 
 /* Options for ParaView presets; umbra_paraview_options_init sets the defaults. */
 typedef struct umbra_paraview_options {
     size_t struct_size;      /* sizeof(umbra_paraview_options); set by
                                 umbra_paraview_options_init */
     const char *preset;      /* the "Name" to pick in a file of several; NULL (default): the
-                                first */
-    uint32_t resolution;     /* table entries, 2..65536 (default 1024) */
+                                first. With no path, the name looked up in the preset search
+                                path */
+    uint32_t resolution;     /* table entries, 2..65536 (default 1024); a categorical preset
+                                gets more where its categories need them (4 per unit of value) */
     int range_given;         /* 0 (default): the table spans the preset's own x range */
     double range_min, range_max; /* with range_given: the data values the table spans */
+    /* Added in 0.5; a struct_size of 0.4's layout (offsetof this field) gets its default. */
+    double default_opacity;  /* in [0,1]: the opacity of a preset without "Points" (default
+                                UMBRA_PARAVIEW_DEFAULT_OPACITY) */
 } umbra_paraview_options;
 
 /* Fills options with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_paraview_options_init(umbra_paraview_options *options);
 
 /* Reads a ParaView JSON colour-map preset (RGBPoints, Points with midpoint and sharpness,
- * ColorSpace RGB / Lab / CIELAB / Diverging / Step; see the README) and evaluates it into a table
- * of options->resolution entries over a data range: the preset's own (smallest to largest x of its
- * points) or options' range, and gives the table that data range
+ * ColorSpace RGB / HSV / Lab / CIELAB / Diverging / Step, HSVWrap; categorical IndexedColors with
+ * Annotations; see the README) and evaluates it into a table of options->resolution entries
+ * over a data range: the preset's own (smallest to largest x of its points; a categorical
+ * preset's values +-0.5) or options' range, and gives the table that data range
  * (umbra_transfer_function_set_range), so renderers place it over each volume's values in data
- * units (e.g. Hounsfield units). options may be NULL (defaults). range, if not NULL, receives
- * the data range the table spans. Malformed files are UMBRA_ERROR_FORMAT naming the key and
- * point; unsupported colour spaces UMBRA_ERROR_UNSUPPORTED. */
+ * units (e.g. Hounsfield units). A categorical preset is a step table: values within 0.5 of an
+ * annotated value take its colour, others are transparent. options may be NULL (defaults).
+ * path NULL: options->preset is looked up by name in the preset search path, in order: each
+ * directory of $UMBRA_PRESET_PATH (':'-separated), the presets installed with umbra
+ * (<prefix>/share/umbra/presets, found from the library's own location; <build>/share/umbra/
+ * presets in a build tree), the current directory; in each, the .json files in name order, the
+ * first holding that Name wins (else UMBRA_ERROR_IO naming the directories). range, if not NULL,
+ * receives the data range the table spans. Malformed files are UMBRA_ERROR_FORMAT naming the key
+ * and point; a file of more than 64 MiB or 2^20 JSON values is refused before it is parsed;
+ * the Lab/CIEDE2000 colour space is UMBRA_ERROR_UNSUPPORTED. */
 UMBRA_API umbra_status umbra_transfer_function_load_paraview(umbra_context ctx, const char *path,
                                                              const umbra_paraview_options *options,
                                                              umbra_transfer_function *out,

@@ -258,12 +258,34 @@ void bind_objects(nb::module_ &m)
             },
             "path"_a, nb::kw_only(), "data_roots"_a = nb::none(),
             "Loads .nrrd/.nhdr (Teem), .nii/.nii.gz (NIfTI-1/2, nifticlib), .mha/.mhd "
-            "(MetaImage) or .dat (Voreen) through umbra_io, with the file's spacing and world "
-            "transform (NRRD space directions, NIfTI sform/qform, MetaImage Offset and "
-            "TransformMatrix). A detached data file (NRRD 'data file', MetaImage ElementDataFile, "
-            "Voreen ObjectFileName) must lie in the header's own directory (after symbolic links "
-            "and '..'), else umbra.Error ERROR_IO naming it; data_roots, a list of directories, "
+            "(MetaImage), .dat (Voreen), .tif/.tiff (TIFF stacks, OME-TIFF), .dcm (DICOM), or a "
+            "directory (a DICOM series, or a TIFF stack when it holds .tif files) through "
+            "umbra_io, with the file's spacing and world transform (NRRD space directions, "
+            "NIfTI sform/qform, MetaImage Offset and TransformMatrix, DICOM patient space). A "
+            "detached data file (NRRD 'data file', MetaImage ElementDataFile, Voreen "
+            "ObjectFileName) must lie in the header's own directory (after symbolic links and "
+            "'..'), else umbra.Error ERROR_IO naming it; data_roots, a list of directories, "
             "allows those too ('/' allows any file).")
+        .def(
+            "load_volume",
+            [](Context &c, const std::vector<std::string> &paths) {
+                std::vector<const char *> p;
+                bool tiff = !paths.empty();
+                for (const std::string &s : paths) {
+                    p.push_back(path_arg(s, "umbra.Context.load_volume: paths entry"));
+                    size_t dot = s.rfind('.');
+                    std::string ext = dot == std::string::npos ? "" : s.substr(dot);
+                    tiff &= ext == ".tif" || ext == ".tiff" || ext == ".TIF" || ext == ".TIFF";
+                }
+                umbra_volume v = nullptr;
+                check(c.get(), tiff ? umbra_volume_load_tiff(c.get(), p.data(), p.size(), &v)
+                                    : umbra_volume_load_dicom(c.get(), p.data(), p.size(), &v));
+                return Volume(c.h, v);
+            },
+            "paths"_a,
+            "Loads a list of files as one volume: single-page TIFFs (all named .tif/.tiff) as "
+            "slices in the order given (umbra_volume_load_tiff), else the files of one DICOM "
+            "series in any order, sorted by position (umbra_volume_load_dicom).")
         .def(
             "load_transfer_function",
             [](Context &c, const std::string &path) {

@@ -41,8 +41,12 @@ def test_paths_with_nul_are_refused_naming_the_argument(ctx, tmp_path):
         assert "contains a NUL character (at " in text and "a.png\\x00.txt" in text, text
     # Nothing was written under the cut name, and the context still works.
     assert (tmp_path / "a.png").read_bytes() == b""
-    ctx.write_image(str(tmp_path / "ok.png"), np.ones((2, 2, 4), np.float32))
-    assert (tmp_path / "ok.png").stat().st_size > 0
+    if umbra.has_image_io:
+        ctx.write_image(str(tmp_path / "ok.png"), np.ones((2, 2, 4), np.float32))
+        assert (tmp_path / "ok.png").stat().st_size > 0
+    else:   # the wheel has no image I/O: show the context works by rendering
+        with umbra.Scene(ctx, "spheres", 16).renderer() as r:
+            assert r.render(8, 8)[..., 3].max() > 0
 
 
 def test_write_image_with_nul_writes_nothing(ctx, tmp_path):

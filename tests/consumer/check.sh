@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # tests/consumer/check.sh SOURCE_DIR BUILD_DIR: umbra as an application takes it in.
 #  1. `cmake --install` into a fresh prefix; no installed file, binaries included, names the source
-#     or build tree.
+#     or build tree; the installed umbra-render finds an installed preset by name.
 #  2. The consumers (a copy of this folder, outside the source tree) build and run against the
 #     prefix alone through find_package(umbra), then through pkg-config (umbra, umbra-io, and the
 #     static libraries with --static), then with umbra as an add_subdirectory of theirs.
@@ -35,6 +35,13 @@ for f in umbra.h io.h config.h context.h registry.h techniques/list.h techniques
 done
 [ -x "$prefix/bin/umbra-render" ] || fail "umbra-render not installed"
 "$prefix/bin/umbra-render" --version | grep -q "umbra-render" || fail "umbra-render --version"
+for f in paraview.json LICENSE; do
+  [ -f "$prefix/share/umbra/presets/$f" ] || fail "not installed: share/umbra/presets/$f"
+done
+# The installed tool finds an installed preset by name, from a directory that holds none.
+(cd "$work" && env -u UMBRA_PRESET_PATH "$prefix/bin/umbra-render" --tf "Cool to Warm" \
+   --technique none --size 16x16 --out "$work/preset.png" 2>/dev/null) ||
+  fail "the installed umbra-render does not find the preset \"Cool to Warm\" by name"
 # Every installed file, binaries included (-a): a path left by __FILE__ or the debug information
 # names the machine that built it (CMakeLists.txt maps both trees away with -ffile-prefix-map).
 named=$(grep -rlaF -e "$src" -e "$build" "$prefix" || true)

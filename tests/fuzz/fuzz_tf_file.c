@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/fuzz/fuzz_tf_file.c: libFuzzer harness for the transfer-function text format
- * (umbra_transfer_function_load, io/tf_file.c): any bytes must give a table or a status with a
- * message, never a crash, hang, leak or sanitizer report. */
+ * (umbra_transfer_function_load, io/tf_file.c) and, for inputs that start with '[' or '{',
+ * ParaView JSON presets (written as input.json: io/paraview.c, cJSON): any bytes must give a
+ * table or a status with a message, never a crash, hang, leak or sanitizer report. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "fuzz_util.h"
@@ -9,7 +10,8 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     umbra_context ctx = fuzz_context();
-    const char *path = fuzz_path("input.tf");
+    const char *path = fuzz_path(size > 0 && (data[0] == '[' || data[0] == '{') ? "input.json"
+                                                                               : "input.tf");
     umbra_transfer_function tf = NULL;
     fuzz_write(path, data, size);
     umbra_status st = umbra_transfer_function_load(ctx, path, &tf);

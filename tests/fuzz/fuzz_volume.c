@@ -5,8 +5,10 @@
  * the same way, 3 a headerless raw file with dims, type and header bytes taken from the next four
  * bytes, 4 a MetaImage .mha, 5 a MetaImage .mhd over "data.raw" as for 1 and 2 (its ElementDataFile
  * must say data.raw to reach it), 6 a NIfTI-1/2 .nii, 7 the same bytes gzip-compressed as a
- * .nii.gz. Everything must end in a volume or a status with a message, never a crash, leak or
- * sanitizer report, and the context must stay usable (the next input uses it).
+ * .nii.gz, 8 a DICOM file (.dcm: umbra's structure walk, then GDCM's decoders), 9 a TIFF (.tif:
+ * libtiff, OME-XML through expat). Everything must end in a volume or a status with a message,
+ * never a crash, leak or sanitizer report, and the context must stay usable (the next input uses
+ * it).
  *
  * Speed: the loaders refuse any size the file cannot hold, so with libFuzzer's -max_len 4096 raw
  * volumes stay small; only ZRL can legitimately expand 4 kB into 64 MB of voxels, so inputs that
@@ -41,14 +43,15 @@ static double declared_voxels(const char *text)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char *const names[8] = {"input.nrrd", "input.nhdr", "input.dat", NULL,
-                                         "input.mha",  "input.mhd",  "input.nii", "input.nii.gz"};
+    static const char *const names[10] = {"input.nrrd", "input.nhdr", "input.dat", NULL,
+                                          "input.mha",  "input.mhd",  "input.nii", "input.nii.gz",
+                                          "input.dcm",  "input.tif"};
     if (size < 1)
         return 0;
     umbra_context ctx = fuzz_context();
     umbra_volume vol = NULL;
     umbra_status st;
-    int mode = data[0] % 8;
+    int mode = data[0] % 10;
     ++data;
     --size;
     if (mode != 3) {
