@@ -19,26 +19,12 @@
 #include "setting.h"
 #include "test_util.h"
 
-enum { NX = 40, NY = 32, NZ = 36, W = 48, H = 40, PIXELS = W * H * 4 };
+enum { NX = CONF_TWO_BALLS_NX, NY = CONF_TWO_BALLS_NY, NZ = CONF_TWO_BALLS_NZ };
+enum { W = 48, H = 40, PIXELS = W * H * 4 };
 
 static umbra_context ctx;
 static umbra_volume vol;
 static umbra_transfer_function tf_a, tf_b;
-
-/* Two soft balls of different density over a thin slab: partial shadows in colour. */
-static float scene_value(float x, float y, float z)
-{
-    x += 0.5f * NX, y += 0.5f * NY, z += 0.5f * NZ;
-    float d1 = sqrtf((x - 14.0f) * (x - 14.0f) + (y - 20.0f) * (y - 20.0f) +
-                     (z - 15.0f) * (z - 15.0f)) - 7.0f;
-    float d2 = sqrtf((x - 27.0f) * (x - 27.0f) + (y - 17.0f) * (y - 17.0f) +
-                     (z - 22.0f) * (z - 22.0f)) - 5.0f;
-    float v = fmaxf(0.6f * fminf(1.0f, fmaxf(0.0f, 0.5f - d1)),
-                    0.9f * fminf(1.0f, fmaxf(0.0f, 0.5f - d2)));
-    if (y > 5.0f && y < 7.0f)
-        v = fmaxf(v, 0.35f);
-    return v;
-}
 
 static int setup(void **state)
 {
@@ -48,7 +34,7 @@ static int setup(void **state)
                          0.7f, 0.7f, 0.9f, 0.5f};
     const float b[16] = {0, 0, 0, 0, 0.9f, 0.5f, 0.2f, 0.15f, 0.3f, 0.8f, 0.4f, 0.4f,
                          0.7f, 0.7f, 0.9f, 0.8f};
-    if (rc == 0 && (conf_volume(ctx, NX, NY, NZ, scene_value, &vol) != UMBRA_SUCCESS ||
+    if (rc == 0 && (conf_volume(ctx, NX, NY, NZ, conf_two_balls, &vol) != UMBRA_SUCCESS ||
                     umbra_transfer_function_create(ctx, a, 4, &tf_a) != UMBRA_SUCCESS ||
                     umbra_transfer_function_create(ctx, b, 4, &tf_b) != UMBRA_SUCCESS))
         rc = -1;
