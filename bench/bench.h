@@ -35,6 +35,7 @@ int bench_interactive(int argc, char **argv); /* bench/interactive.c */
 int bench_builds(int argc, char **argv);   /* bench/builds.c */
 int bench_conformance(int argc, char **argv); /* bench/conformance.c */
 int bench_progress(int argc, char **argv); /* bench/progress.c */
+int bench_features(int argc, char **argv); /* bench/features.c */
 
 /* ---- timing -------------------------------------------------------------------------------------- */
 

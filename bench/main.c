@@ -24,6 +24,8 @@ static const bench_command commands[] = {
      "rewrite the README's measured blocks (headline table, pictures) from the accuracy results"},
     {"conformance", bench_conformance,
      "every technique's errors in the conformance suite's cases beside the bounds it asserts"},
+    {"features", bench_features,
+     "the cost of clipping, projection modes, channels, label maps and volume updates (#31)"},
     {"scale", bench_scale,
      "time to first frame, frame times and memory against volume size (128^3 .. 1024^3 and up)"},
 };

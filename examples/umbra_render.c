@@ -84,6 +84,8 @@ void session_end(session *s)
     umbra_renderer_release(s->renderer);
     umbra_transfer_function_release(s->light_tf);
     umbra_transfer_function_release(s->tf);
+    for (int c = 0; c < UMBRA_MAX_CHANNELS - 1; ++c)
+        umbra_transfer_function_release(s->channel_tf[c]);
     umbra_volume_release(s->volume);
     umbra_scene_release(&s->scene);
     umbra_context_release(s->ctx);
@@ -178,6 +180,10 @@ int session_begin(const options *o, session *s)
     if (o->light_tf &&
         (st = load_tf(s->ctx, o->light_tf, o->tf_preset, &s->light_tf)) != UMBRA_SUCCESS)
         return exit_status(st);
+    for (uint32_t c = 0; c < o->channel_tf_count; ++c)
+        if ((st = load_tf(s->ctx, o->channel_tf[c], o->tf_preset, &s->channel_tf[c])) !=
+            UMBRA_SUCCESS)
+            return exit_status(st);
     /* The library checks LO < HI and names the values. */
     if (o->have_tf_range &&
         ((st = umbra_transfer_function_set_range(tf, o->tf_range[0], o->tf_range[1])) !=
@@ -218,6 +224,7 @@ int session_begin(const options *o, session *s)
     rd.jitter = o->jitter;
     rd.preintegrated = o->preintegrated;
     rd.interaction = o->interaction;
+    rd.mode = o->mode;
     if (o->have_seed) rd.seed = o->seed;
     if (o->have_background) memcpy(rd.background, o->background, sizeof rd.background);
     else { rd.background[0] = 0.08f; rd.background[1] = 0.08f; rd.background[2] = 0.1f; rd.background[3] = 1.0f; }
@@ -230,14 +237,29 @@ int session_begin(const options *o, session *s)
         (s->light_tf && (st = umbra_renderer_set_light_transfer_function(r, s->light_tf))) ||
         (st = umbra_renderer_set_camera(r, &cam)) || (st = umbra_renderer_set_light(r, &light)) ||
         (st = umbra_renderer_set_options(r, &rd)) ||
-        (st = umbra_renderer_set_shadow(r, &o->shadow)))
+        (st = umbra_renderer_set_shadow(r, &o->shadow)) ||
+        (st = umbra_renderer_set_clip(r, &o->clip)))
         return exit_status(st);
+    /* Channels 1.. of a multi-channel volume: their own transfer functions, else channel 0's. */
+    umbra_volume_info vinfo;
+    umbra_volume_get_info(vol, &vinfo);
+    if (o->channel_tf_count >= vinfo.channels && o->channel_tf_count > 0) {
+        fprintf(stderr, "%s: %u --channel-tf for a volume of %u channel%s\n", o->program,
+                o->channel_tf_count, vinfo.channels, vinfo.channels == 1 ? "" : "s");
+        return 1;
+    }
+    for (uint32_t c = 1; c < vinfo.channels; ++c)
+        if ((st = umbra_renderer_set_channel_transfer_function(
+                 r, c, c <= o->channel_tf_count ? s->channel_tf[c - 1] : tf, NULL)) !=
+            UMBRA_SUCCESS)
+            return exit_status(st);
     s->view_volume = vol;
     s->view_tf = tf;
     s->camera = cam;
     s->light = light;
     s->options = rd;
     s->shadow = o->shadow;
+    s->clip = o->clip;
     s->width = o->width;
     s->height = o->height;
     s->out = o->out;

@@ -38,6 +38,10 @@ typedef struct options {
     umbra_shadow_desc shadow; /* the technique and every parameter given (registry keys) */
     const char *data_roots[1024]; /* --allow-data-root, borrowed from argv */
     size_t data_root_count;
+    umbra_render_mode mode;       /* --mode */
+    umbra_clip_desc clip;         /* --clip-plane, --crop */
+    const char *channel_tf[UMBRA_MAX_CHANNELS - 1]; /* --channel-tf: channels 1.. */
+    uint32_t channel_tf_count;
 } options;
 
 /* Fills o from the command line. Returns 0, or prints what is wrong to stderr and returns 1 (bad
@@ -80,6 +84,7 @@ typedef struct session {
     umbra_scene scene;
     umbra_volume volume;
     umbra_transfer_function tf, light_tf;
+    umbra_transfer_function channel_tf[UMBRA_MAX_CHANNELS - 1]; /* --channel-tf */
     umbra_renderer renderer;
     float *pixels;
     /* As set on the renderer by session_begin: */
@@ -89,6 +94,7 @@ typedef struct session {
     umbra_light light;
     umbra_render_desc options;
     umbra_shadow_desc shadow;
+    umbra_clip_desc clip;            /* --clip-plane, --crop */
     uint32_t width, height;          /* --size */
     const char *out;                 /* --out, checked to be a writable .png or .exr path */
 } session;

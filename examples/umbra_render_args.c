@@ -151,7 +151,8 @@ enum {
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_ORTHO, OPT_LIGHT_DIR, OPT_LIGHT_POS,
     OPT_LIGHT_COLOR, OPT_AMBIENT, OPT_STEP, OPT_SHADING, OPT_NO_SHADING, OPT_GROUND,
     OPT_NO_GROUND, OPT_COLORED, OPT_GREY, OPT_BACKGROUND, OPT_JITTER, OPT_SEED, OPT_PREINTEGRATED,
-    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION,
+    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION, OPT_MODE, OPT_CLIP_PLANE, OPT_CROP,
+    OPT_RAW_CHANNELS, OPT_LABELS, OPT_CHANNEL_TF,
     OPT_PARAM = 1024,  /* + the index of a technique option */
     OPT_PROGRAM = 2048 /* + the index of an option of the program's own (parse_args_as) */
 };
@@ -180,10 +181,21 @@ static const fixed_option fixed[] = {
     {"raw-dims", OPT_RAW_DIMS, "XxYxZ", "the raw file's voxels per axis"},
     {"raw-type", OPT_RAW_TYPE, "T", "the raw file's voxel type: uint8, uint16, int16 or float32"},
     {"raw-big-endian", OPT_RAW_BIG_ENDIAN, NULL, "the raw file is big-endian"},
+    {"raw-channels", OPT_RAW_CHANNELS, "N", "the raw file holds N interleaved values per voxel: "
+                                            "2..4 make a multi-channel volume, each channel "
+                                            "with its own range and transfer function "
+                                            "(--channel-tf; default 1)"},
+    {"labels", OPT_LABELS, NULL, "the raw file's uint8/uint16 voxels are labels: sampled at the "
+                                 "nearest voxel, label l taking entry l of the transfer function "
+                                 "(in the text format: resolution L, label l's point at value "
+                                 "l/(L-1))"},
     {"tf", OPT_TF, "FILE", "transfer function: text format (see README) or a ParaView preset "
                            ".json (x in the volume's data units)"},
     {"tf-preset", OPT_TF_PRESET, "NAME", "the preset to pick from a .json holding several"},
     {"light-tf", OPT_LIGHT_TF, "FILE", "separate transfer function for the light pass"},
+    {"channel-tf", OPT_CHANNEL_TF, "FILE", "transfer function of the next channel of a "
+                                           "multi-channel volume: channel 1, then 2, then 3 "
+                                           "(channel 0 takes --tf; repeatable)"},
     {"tf-range", OPT_TF_RANGE, "LO,HI", "the transfer functions span data values LO..HI "
                                         "(overrides a file's range line: an HU preset on data "
                                         "stored as HU + 1024 takes --tf-range 0,4095)"},
@@ -218,6 +230,14 @@ static const fixed_option fixed[] = {
     {"interaction", OPT_INTERACTION, "MODE", "off (default) or auto: a frame after a light or "
                                              "transfer-function change uses the technique's "
                                              "draft, the next unchanged one the full map"},
+    {"mode", OPT_MODE, "NAME", "render mode: composite (default: lit, shadowed), mip, minip or "
+                               "average (intensity projections, unlit: technique none)"},
+    {"clip-plane", OPT_CLIP_PLANE, "A,B,C,D", "keep the side a x + b y + c z + d >= 0 of a plane "
+                                              "in the volume's world, for the view and the light "
+                                              "alike (repeatable, up to 6)"},
+    {"crop", OPT_CROP, "X0,Y0,Z0,X1,Y1,Z1", "keep only the box of voxel coordinates [X0, X1] x "
+                                            "[Y0, Y1] x [Z0, Z1] (voxel centres at whole "
+                                            "numbers), for the view and the light alike"},
     {"device", OPT_DEVICE, "SPEC", "OpenCL device: P:D indices or a name substring"},
     {"progress", OPT_PROGRESS, NULL, "progress line on stderr (default: when it is a terminal; "
                                      "--no-progress: never)"},
@@ -538,6 +558,7 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
     o->shading = o->ground = o->colored = o->progress = -1;
     umbra_raw_desc_init(&o->raw_desc);
     umbra_shadow_desc_init(&o->shadow);
+    umbra_clip_desc_init(&o->clip);
     make_param_options();
 
     struct option longopts[FIXED_COUNT + MAX_PARAM_OPTIONS + MAX_PROGRAM_OPTIONS + 1];
@@ -773,6 +794,45 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
         }
         case OPT_PROGRESS: o->progress = 1; break;
         case OPT_NO_PROGRESS: o->progress = 0; break;
+        case OPT_MODE: {
+            static const char *names[] = {"composite", "mip", "minip", "average"};
+            int k = -1;
+            for (int m = 0; m < 4; ++m)
+                if (strcmp(v, names[m]) == 0)
+                    k = m;
+            if (k < 0)
+                FAIL("--mode '%s' is not composite, mip, minip or average", v);
+            o->mode = (umbra_render_mode)k;
+            break;
+        }
+        case OPT_CLIP_PLANE:
+            if (o->clip.plane_count == UMBRA_MAX_CLIP_PLANES)
+                FAIL("at most %d --clip-plane", UMBRA_MAX_CLIP_PLANES);
+            if (!parse_floats(v, o->clip.planes[o->clip.plane_count], 4))
+                FAIL("--clip-plane '%s' is not A,B,C,D", v);
+            o->clip.plane_count++;
+            break;
+        case OPT_CROP: {
+            float b[6];
+            if (!parse_floats(v, b, 6))
+                FAIL("--crop '%s' is not X0,Y0,Z0,X1,Y1,Z1", v);
+            o->clip.crop = 1;
+            memcpy(o->clip.crop_min, b, sizeof o->clip.crop_min);
+            memcpy(o->clip.crop_max, b + 3, sizeof o->clip.crop_max);
+            break;
+        }
+        case OPT_RAW_CHANNELS:
+            if (!parse_u32_n(v, strlen(v), 1, UMBRA_MAX_CHANNELS, &o->raw_desc.channels))
+                FAIL("--raw-channels '%s' is not a whole number in [1, %d]", v,
+                     UMBRA_MAX_CHANNELS);
+            break;
+        case OPT_LABELS: o->raw_desc.labels = 1; break;
+        case OPT_CHANNEL_TF:
+            if (o->channel_tf_count == UMBRA_MAX_CHANNELS - 1)
+                FAIL("at most %d --channel-tf (channels 1 to %d)", UMBRA_MAX_CHANNELS - 1,
+                     UMBRA_MAX_CHANNELS - 1);
+            o->channel_tf[o->channel_tf_count++] = v;
+            break;
         default:
             if (c >= OPT_PROGRAM) {
                 if (p->take(p->user, (size_t)(c - OPT_PROGRAM), v) != 0)
@@ -795,6 +855,11 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
             goto done;
     if (o->raw && (!o->have_raw_dims || !o->have_raw_type)) {
         fprintf(stderr, "%s: --raw needs --raw-dims and --raw-type\n", program_name);
+        goto done;
+    }
+    if ((o->raw_desc.channels > 1 || o->raw_desc.labels) && !o->raw) {
+        fprintf(stderr, "%s: --raw-channels and --labels describe a --raw file\n",
+                program_name);
         goto done;
     }
     if (o->have_light_dir && o->have_light_pos) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/frame.c: the constants a frame's kernels read (umbra__frame: light, view, box, options),
- * brought up to date from the renderer's state and uploaded; the build options and the kernel
- * arguments every technique's kernels share. */
+ * brought up to date from the renderer's state and uploaded; the orbit cameras; the build
+ * options and the kernel arguments every technique's kernels share. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,6 +35,12 @@ void umbra__frame_update_light(umbra_renderer r)
     F->dims[3] = 0;
     F->bricks[3] = (int32_t)v->brick_size;
     set4(F->value_map, v->value_map[0], v->value_map[1], v->value_map[2], 0.0f);
+    F->ch.count = v->channels;
+    F->ch.labels = v->labels ? 1u : 0u;
+    for (uint32_t c = 0; c < UMBRA_MAX_CHANNELS; ++c)
+        for (int k = 0; k < 3; ++k)
+            F->ch.value_map[c][k] = c < v->channels ? v->channel_map[c][k] : 0.0f;
+    umbra__clip_update(r);
     /* The light is given in the volume's world; the kernels work in its local frame. */
     const umbra_light *l = &r->light;
     float lp[3];
@@ -55,10 +61,42 @@ void umbra__frame_update_light(umbra_renderer r)
         F->flags |= UMBRA_FLAG_SKIP_EMPTY;
     F->step_ref = umbra__voxel_world(r);
     F->light_tf_size = umbra__light_tf(r)->count;
-    r->channels = (r->opts.transmission == UMBRA_TRANSMISSION_GREY ||
-                   umbra_transfer_function_is_grey(umbra__light_tf(r)))
+    r->channels = (r->opts.transmission == UMBRA_TRANSMISSION_GREY || umbra__light_tfs_grey(r))
                       ? 1u
                       : 3u;
+}
+
+/* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
+ * (0, -1e20, 0) would get length inf and normalise to zero), never a double. */
+umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees)
+{
+    const float origin[3] = {0.0f, 0.0f, 0.0f};
+    return umbra_camera_orbit_at(origin, dir, box_diagonal, fovy_degrees);
+}
+
+umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], float box_diagonal,
+                                   float fovy_degrees)
+{
+    umbra_camera c;
+    memset(&c, 0, sizeof c);
+    float d[3] = {dir[0], dir[1], dir[2]};
+    umbra__normalize3(d);
+    if (!(fovy_degrees > 0.0f && fovy_degrees < 180.0f))
+        fovy_degrees = 30.0f;
+    float dist = 0.5f * box_diagonal / sinf(0.5f * fovy_degrees * 3.14159265f / 180.0f) * 1.05f;
+    c.projection = UMBRA_PERSPECTIVE;
+    for (int i = 0; i < 3; ++i) {
+        c.eye[i] = center[i] + d[i] * dist;
+        c.target[i] = center[i];
+    }
+    c.up[1] = 1.0f;
+    if (fabsf(d[1]) > 0.99f) { /* looking straight down or up: y cannot be "up" */
+        c.up[1] = 0.0f;
+        c.up[2] = -1.0f;
+    }
+    c.fovy_degrees = fovy_degrees;
+    c.ortho_height = box_diagonal;
+    return c;
 }
 
 void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
@@ -225,12 +263,18 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
      * (the context caches both). */
     static const char *const voxel_t[] = {"uchar", "ushort", "short", "float"};
     umbra_scalar_type t = r->volume ? r->volume->stored_type : UMBRA_FLOAT32;
+    const int image = r->volume ? umbra__volume_images(r->volume)
+                                : r->ctx->sampler == UMBRA_SAMPLER_IMAGE;
     int n = snprintf(buf, size,
                      "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s "
                      "-DUMBRA_VOXEL_CLAMPS=%d",
-                     r->ctx->sampler == UMBRA_SAMPLER_IMAGE ? 1 : 0, r->channels,
-                     voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
+                     image, r->channels, voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
                      r->volume ? r->volume->clamps : 1);
+    /* A multi-channel volume or a label map (kernels/common/channels.cl); a plain volume adds
+     * nothing, so its programs stay what they were. */
+    if (r->volume && (r->volume->channels > 1 || r->volume->labels) && n > 0 && (size_t)n < size)
+        n += snprintf(buf + n, size - (size_t)n, " -DUMBRA_CHANNELS=%u -DUMBRA_LABELS=%d",
+                      r->volume->channels, r->volume->labels ? 1 : 0);
     /* A volume in several slabs: kernels/common/sampling.cl takes one parameter per slab. One slab
      * adds
      * nothing, so its programs stay those of the single-buffer code. */

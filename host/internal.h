@@ -159,6 +159,28 @@ struct umbra_volume_t {
     double origin[3];        /* world position of voxel (0, 0, 0)'s centre */
     double axes[9];          /* orthonormal world direction of index axis a in axes[3a..3a+2] */
     double centre0[3];       /* local position of voxel (0, 0, 0)'s centre, (0.5 - dims/2) spacing */
+    /* Channels and labels (volume.h). With channels > 1 the tables above hold channel 0's
+     * ranges followed by each further channel's (brick_minmax: 2 nbricks floats a channel,
+     * cell_minmax: 2 ncells), every channel's voxels lie in slabs[0] one after the other
+     * (dims[0] dims[1] dims[2] + 1 elements each: the pad), and channel c's value map and range
+     * are channel_map[c], channel_range[c] (channel 0's also in value_map, value_min/max). A
+     * label map keeps the raw labels in its tables and one buffer. */
+    uint32_t channels;
+    int labels;
+    float channel_map[UMBRA_MAX_CHANNELS][3];
+    float channel_range[UMBRA_MAX_CHANNELS][2];
+    double range_d[UMBRA_MAX_CHANNELS][2]; /* each channel's value range in double, as its
+                                mapping was made */
+    int stored_form;         /* UMBRA__STORED_* */
+    umbra_scalar_type input_type; /* the type the voxels were given in (and updates give) */
+    /* Updates (umbra_volume_update, host/volume_update.c): version counts them; ranges_version
+     * counts those that changed some brick or sub-cell range (renderers remake their
+     * visibility tables then); cell_clamps flags the sub-cells (per channel) whose footprint
+     * holds a voxel outside the value range, clamp_cells counts them (clamps = clamp_cells > 0
+     * for the forms that normalise in the kernels). */
+    uint64_t version, ranges_version;
+    unsigned char *cell_clamps;
+    size_t clamp_cells;
 };
 #endif
 
@@ -207,6 +229,46 @@ umbra_status umbra__slabs_read(umbra_volume v, void *out, size_t voxel_bytes);
 /* v's voxels read back and normalised to [0,1] as the kernels normalise them (voxel_normalise in
  * kernels/common/sampling.cl): dims[0] * dims[1] * dims[2] floats into out, x fastest. Blocks. */
 umbra_status umbra__volume_read_normalised(umbra_volume v, float *out);
+
+/* The first of count float voxels that is NaN or infinite, or count when all are finite; in
+ * parallel (host/volume_ranges.c). */
+size_t umbra__first_nonfinite(const float *data, size_t count);
+
+/* The raw min and max (in type's values, as floats) over the footprint of every sub-cell and
+ * brick of the bricks [b0, b0 + nb) per axis of v's brick grid, from block, the voxels
+ * [origin, origin + bdims) of one channel (x fastest, of type), which must hold those
+ * footprints: 2 floats per sub-cell into cells (brick-major over the nb bricks,
+ * UMBRA_BRICK_CELLS^3 a brick, x fastest) and per brick into bricks. In parallel; 0 when out of
+ * memory (host/volume_ranges.c). */
+int umbra__block_ranges(umbra_volume v, const void *block, umbra_scalar_type type,
+                        const uint32_t origin[3], const uint32_t bdims[3], const uint32_t b0[3],
+                        const uint32_t nb[3], float *cells, float *bricks);
+
+/* How a volume's voxels are stored on the device (umbra_volume_t.stored_form). */
+enum {
+    UMBRA__STORED_RAW,        /* the input's values as they are */
+    UMBRA__STORED_BIASED_U16, /* int16 + 32768 as uint16 (a CL_UNORM_INT16 image) */
+    UMBRA__STORED_NORMALISED  /* normalised float32, computed in double as the range's mapping
+                                 is */
+};
+
+/* Voxels first .. first + n - 1 of src (of type) in stored form `form` (not RAW) into dst:
+ * biased, or normalised by (v - lo) scale and clamped to [0, 1] (host/volume.c). */
+void umbra__convert_voxels(const void *src, umbra_scalar_type type, size_t first, size_t n,
+                           int form, double lo, double scale, void *dst);
+
+/* Values first .. first + n - 1 of channel c of src (channels values of esize bytes per voxel,
+ * interleaved) into dst, one after the other (host/volume.c). */
+void umbra__channel_copy(const void *src, size_t esize, uint32_t channels, uint32_t c,
+                         size_t first, size_t n, void *dst);
+
+/* Raw ranges (n floats of channel c, in the input's values) mapped in place to the normalised
+ * values the kernels see, clamped to [0, 1], as the volume was made (host/volume.c). */
+void umbra__map_ranges(umbra_volume v, uint32_t c, float *values, size_t n);
+
+/* Nonzero when v keeps its voxels in 3D images: the image sampler's plain scalar volumes (a
+ * multi-channel volume or a label map is one buffer on every sampler). */
+int umbra__volume_images(umbra_volume v);
 
 /* Validates desc's index-to-world transform and sets v's (the identity map without one);
  * UMBRA_ERROR_UNSUPPORTED for sheared axes. host/world.c. */

@@ -376,10 +376,17 @@ void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t,
     const uint32_t by = t->info.rebuilt_by;
     memset(key, 0, sizeof *key);
     key->technique = (int)t->info.id;
-    if (by & UMBRA_REBUILD_VOLUME)
+    if (by & UMBRA_REBUILD_VOLUME) {
         key->volume_id = r->volume->id;
-    if (by & UMBRA_REBUILD_LIGHT_TF)
+        key->volume_version = r->volume->version;
+    }
+    if (by & UMBRA_REBUILD_LIGHT_TF) {
         key->light_tf_id = umbra__light_tf(r)->id;
+        for (uint32_t c = 1; c < r->volume->channels; ++c)
+            key->channel_light_tf_id[c] = r->ch_light_eff[c] ? r->ch_light_eff[c]->id : 0;
+    }
+    if (by & UMBRA_REBUILD_CLIP)
+        key->clip = r->shadow_params.clip;
     if (by & UMBRA_REBUILD_LIGHT)
         key->light = r->light;
     if (by & UMBRA_REBUILD_TRANSMISSION)

@@ -43,39 +43,6 @@ void umbra_render_desc_init(umbra_render_desc *d)
     d->transmission = UMBRA_TRANSMISSION_GREY;
 }
 
-/* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
- * (0, -1e20, 0) would get length inf and normalise to zero), never a double. */
-umbra_camera umbra_camera_orbit(const float dir[3], float box_diagonal, float fovy_degrees)
-{
-    const float origin[3] = {0.0f, 0.0f, 0.0f};
-    return umbra_camera_orbit_at(origin, dir, box_diagonal, fovy_degrees);
-}
-
-umbra_camera umbra_camera_orbit_at(const float center[3], const float dir[3], float box_diagonal,
-                                   float fovy_degrees)
-{
-    umbra_camera c;
-    memset(&c, 0, sizeof c);
-    float d[3] = {dir[0], dir[1], dir[2]};
-    umbra__normalize3(d);
-    if (!(fovy_degrees > 0.0f && fovy_degrees < 180.0f))
-        fovy_degrees = 30.0f;
-    float dist = 0.5f * box_diagonal / sinf(0.5f * fovy_degrees * 3.14159265f / 180.0f) * 1.05f;
-    c.projection = UMBRA_PERSPECTIVE;
-    for (int i = 0; i < 3; ++i) {
-        c.eye[i] = center[i] + d[i] * dist;
-        c.target[i] = center[i];
-    }
-    c.up[1] = 1.0f;
-    if (fabsf(d[1]) > 0.99f) { /* looking straight down or up: y cannot be "up" */
-        c.up[1] = 0.0f;
-        c.up[2] = -1.0f;
-    }
-    c.fovy_degrees = fovy_degrees;
-    c.ortho_height = box_diagonal;
-    return c;
-}
-
 /* ---- lifetime ------------------------------------------------------------------------------------ */
 
 umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
@@ -186,6 +153,13 @@ void umbra_renderer_release(umbra_renderer r)
     umbra_transfer_function_release(r->light_tf);
     umbra_transfer_function_release(r->view_eff);
     umbra_transfer_function_release(r->light_eff);
+    for (int c = 0; c < UMBRA_MAX_CHANNELS; ++c) {
+        umbra_transfer_function_release(r->ch_tf[c]);
+        umbra_transfer_function_release(r->ch_light_tf[c]);
+        umbra_transfer_function_release(r->ch_view_eff[c]);
+        umbra_transfer_function_release(r->ch_light_eff[c]);
+    }
+    umbra__projection_release(r);
     umbra_context_release(r->ctx);
     free(r);
 }
@@ -335,12 +309,19 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
      * description (umbra_renderer_set_shadow): it keeps its value. umbra 0.5.0's ends with
      * preintegrated: the fields after it (interaction) keep theirs. */
     const size_t size_0_4 = offsetof(umbra_render_desc, preintegrated);
-    const size_t size_0_5 = RENDER_DESC_SIZE_0_5;
-    if (d->struct_size != sizeof *d && d->struct_size != size_0_5 && d->struct_size != size_0_4)
+    /* umbra 0.5's layout ends with preintegrated: its size with its padding, or without it
+     * (offsetof mode). */
+    const size_t size_0_5 = RENDER_DESC_SIZE_0_5, end_0_5 = offsetof(umbra_render_desc, mode);
+    if (d->struct_size != sizeof *d && d->struct_size != size_0_5 && d->struct_size != end_0_5 &&
+        d->struct_size != size_0_4)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: desc->struct_size %zu is neither %zu nor umbra 0.5.0's %zu nor "
-                           "0.4's %zu: call umbra_render_desc_init", fn, d->struct_size,
-                           sizeof *d, size_0_5, size_0_4);
+                           "%s: desc->struct_size %zu is none of %zu, umbra 0.5's %zu (%zu "
+                           "without padding) and umbra 0.4's %zu: call umbra_render_desc_init",
+                           fn, d->struct_size, sizeof *d, size_0_5, end_0_5, size_0_4);
+    if (d->struct_size == sizeof *d && (unsigned)d->mode > UMBRA_RENDER_AVERAGE)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: mode %d is unknown (0 composite, 1 mip, 2 minip, 3 average)", fn,
+                           (int)d->mode);
     if (!(d->step >= 0.01f && d->step <= 64.0f))
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: step %g voxels must lie in [0.01, 64]", fn, d->step);
@@ -374,14 +355,19 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
                            "%s: interaction %d is unknown (UMBRA_INTERACTION_OFF 0 or _AUTO 1)", fn,
                            (int)d->interaction);
     const int preintegrated = r->opts.preintegrated;
+    const umbra_render_mode mode = r->opts.mode;
     const umbra_interaction interaction = r->opts.interaction;
-    memcpy(&r->opts, d, d->struct_size);
+    /* An older layout's bytes up to its last field, never its padding. */
+    memcpy(&r->opts, d, d->struct_size == sizeof *d ? sizeof *d
+                        : d->struct_size < end_0_5  ? d->struct_size
+                                                    : end_0_5);
     r->opts.struct_size = sizeof r->opts;
-    r->opts.reserved = 0;
     if (d->struct_size == size_0_4)
         r->opts.preintegrated = preintegrated;
-    if (d->struct_size != sizeof *d)
+    if (d->struct_size != sizeof *d) {
+        r->opts.mode = mode;
         r->opts.interaction = interaction;
+    }
     return UMBRA_SUCCESS;
 }
 
@@ -422,7 +408,7 @@ static umbra_status check_ready(umbra_renderer r, const char *fn)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: set a volume and a transfer function first (volume %p, tf %p)", fn,
                            (void *)r->volume, (void *)r->tf);
-    return UMBRA_SUCCESS;
+    return umbra__check_kind(r, fn);
 }
 
 /* Refuses a step that would take more than UMBRA_MAX_RAY_SAMPLES samples along the box's
@@ -539,11 +525,11 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share, int fra
  * (float). The shape did not matter (32 x 8, 8 x 32 and 256 x 1 alike; 16 x 4 and 64 x 1 as
  * slow as 8 x 8). The shadow builds keep 8 x 8: with 256 work-items CSSM's blocks left too few
  * work-groups for two cores. Issue #12, docs/performance.md. */
-static void choose_render_local(umbra_renderer r)
+void umbra__choose_local(umbra_renderer r, cl_kernel k, size_t local[2])
 {
     size_t kernel_wg = 0, device_wg = 0, items[3] = {0, 0, 0};
-    r->render_local[0] = r->render_local[1] = 8;
-    if (clGetKernelWorkGroupInfo(r->render_kernel, r->ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
+    local[0] = local[1] = 8;
+    if (clGetKernelWorkGroupInfo(k, r->ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
                                  sizeof kernel_wg, &kernel_wg, NULL) != CL_SUCCESS ||
         clGetDeviceInfo(r->ctx->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof device_wg,
                         &device_wg, NULL) != CL_SUCCESS ||
@@ -551,7 +537,7 @@ static void choose_render_local(umbra_renderer r)
                         NULL) != CL_SUCCESS)
         return; /* 8 x 8, as every kernel of the library may assume */
     if (kernel_wg >= 256 && device_wg >= 256 && items[0] >= 32 && items[1] >= 8)
-        r->render_local[0] = 32;
+        local[0] = 32;
 }
 
 static umbra_status ensure_kernels(umbra_renderer r)
@@ -559,9 +545,10 @@ static umbra_status ensure_kernels(umbra_renderer r)
     char options[256];
     /* common/lightspace.cl: the map projection the light-space techniques' lookups need. */
     static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/channels.cl",
                                          "common/lightspace.cl", "common/preintegration.cl"};
     const char *files[16];
-    const size_t nfiles = umbra__program_files(r->tech, common, 4, "raycast.cl", files, 16);
+    const size_t nfiles = umbra__program_files(r->tech, common, 5, "raycast.cl", files, 16);
     cl_program program;
     umbra__build_options(r, options, sizeof options);
     umbra_status st = umbra__program_get(r->ctx, files, nfiles, options, &program);
@@ -575,7 +562,7 @@ static umbra_status ensure_kernels(umbra_renderer r)
         release_kernels(r);
         return st;
     }
-    choose_render_local(r);
+    umbra__choose_local(r, r->render_kernel, r->render_local);
     r->program = program;
     return UMBRA_SUCCESS;
 }
@@ -583,6 +570,36 @@ static umbra_status ensure_kernels(umbra_renderer r)
 static umbra_timing measured_timing(umbra_renderer r)
 {
     return r->ctx->profiling ? UMBRA_TIMING_DEVICE : UMBRA_TIMING_WALL;
+}
+
+/* Sets every argument of the ray caster for a frame into out. */
+static umbra_status bind_raycast(umbra_renderer r, cl_mem out, const char *fn)
+{
+    umbra_context ctx = r->ctx;
+    cl_uint next = 0;
+    umbra_status st = umbra__bind_common(r, r->render_kernel, &next);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &out));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->samples_buf));
+    /* Pre-integrated ray casting (umbra_render_desc.preintegrated): the view table for the view
+     * step; any buffer stands in for it when the mode is off (table size 0). */
+    cl_mem preint = r->view_tf_buf;
+    cl_uint preint_size = 0;
+    if (r->opts.preintegrated) {
+        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step,
+                                  UMBRA__PREINT_VIEW, 0, &preint, NULL);
+        if (st != UMBRA_SUCCESS)
+            return st;
+        preint_size = UMBRA__PREINT_SIZE;
+    }
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &preint));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof preint_size, &preint_size));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->view_cells_buf));
+    if (r->tech->bind)
+        st = r->tech->bind(r, r->render_kernel, next);
+fail:
+    return st;
 }
 
 /* Renders the frame into out. Blocking frames wait for it; asynchronous ones (r->async) only
@@ -607,8 +624,10 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
-    st = umbra__tables(r, umbra__view_tf(r), r->opts.step, r->view_tf_key, &r->view_tf_buf,
-                &r->view_bricks_buf, &r->view_cells_buf);
+    umbra_transfer_function view_tfs[UMBRA_MAX_CHANNELS];
+    umbra__channel_tfs(r, 0, view_tfs);
+    st = umbra__tables(r, view_tfs, r->opts.step, r->view_tf_key, &r->view_tf_buf,
+                       &r->view_bricks_buf, &r->view_cells_buf);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__frame_update_view(r, width, height);
@@ -621,7 +640,8 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         r->stats.samples = 0;
         return st;
     }
-    st = ensure_kernels(r);
+    const int composite = r->opts.mode == UMBRA_RENDER_COMPOSITE;
+    st = composite ? ensure_kernels(r) : UMBRA_SUCCESS;
     if (st == UMBRA_SUCCESS)
         st = umbra__ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
     if (st == UMBRA_SUCCESS)
@@ -629,27 +649,12 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     cl_ulong zero = 0;
-    cl_uint next = 0;
-    st = umbra__bind_common(r, r->render_kernel, &next);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &out));
-    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->samples_buf));
-    /* Pre-integrated ray casting (umbra_render_desc.preintegrated): the view table for the view
-     * step; any buffer stands in for it when the mode is off (table size 0). */
-    cl_mem preint = r->view_tf_buf;
-    cl_uint preint_size = 0;
-    if (r->opts.preintegrated) {
-        st = umbra__preint_ensure(ctx, fn, &r->preint, umbra__view_tf(r), r->opts.step,
-                                  UMBRA__PREINT_VIEW, 0, &preint, NULL);
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-        preint_size = UMBRA__PREINT_SIZE;
-    }
-    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &preint));
-    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof preint_size, &preint_size));
-    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->view_cells_buf));
-    if (r->tech->bind && (st = r->tech->bind(r, r->render_kernel, next)) != UMBRA_SUCCESS)
+    /* The kernel of the frame: the ray caster, or a projection mode's (host/projection.c). */
+    cl_kernel kernel = r->render_kernel;
+    size_t local[2] = {r->render_local[0], r->render_local[1]};
+    if (!composite && (st = umbra__projection_kernel(r, out, &kernel, local)) != UMBRA_SUCCESS)
+        return st;
+    if (composite && (st = bind_raycast(r, out, fn)) != UMBRA_SUCCESS)
         goto fail;
     size_t global[2] = {width, height};
     if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS)
@@ -666,16 +671,14 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         /* An asynchronous frame is one launch, not waited for: no bands, no progress. */
         r->stats.render_ms = 0.0;
         r->stats.samples = 0;
-        if ((st = umbra__enqueue(ctx, r->render_kernel, 2, global, r->render_local, &ev)) ==
-            UMBRA_SUCCESS)
+        if ((st = umbra__enqueue(ctx, kernel, 2, global, local, &ev)) == UMBRA_SUCCESS)
             st = umbra__async_hold(r, ev, 1);
         goto fail; /* done or failed: the caller hands out the frame's last kernel */
     }
     double ms = 0.0;
-    size_t local[2] = {r->render_local[0], r->render_local[1]};
     const double cost = umbra__march_cost(r, 1);
     umbra__band_local(r, cost, local);
-    st = umbra__run_2d(r, r->render_kernel, global, local, cost, &ms, fn);
+    st = umbra__run_2d(r, kernel, global, local, cost, &ms, fn);
     if (st != UMBRA_SUCCESS)
         goto fail;
     r->stats.render_ms = ms;

@@ -16,8 +16,11 @@
 #include "internal.h"
 #include "common/umbra_shared.h"
 
-_Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12, "UmbraFrame layout");
-_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 4 * 4, "UmbraShadow layout");
+_Static_assert(sizeof(UmbraChannels) == 4 * 16 + 4 * 16 + 16, "UmbraChannels layout");
+_Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12 + sizeof(UmbraChannels),
+               "UmbraFrame layout");
+_Static_assert(sizeof(UmbraClip) == 8 * 16 + 16, "UmbraClip layout");
+_Static_assert(sizeof(UmbraShadow) == 6 * 16 + 4 * 4 + sizeof(UmbraClip), "UmbraShadow layout");
 
 /* A parameter: what umbra/registry.h shows, and where its value lives in umbra_shadow_desc. */
 typedef struct umbra__param {
@@ -110,7 +113,22 @@ typedef struct umbra__light_key {
     int transmission, skip_empty;
     int technique;
     double params[UMBRA__MAX_PARAMS];
+    /* Appended for the clip region, multi-channel volumes and volume updates: the clip region
+     * in the local frame (UMBRA_REBUILD_CLIP), the volume's voxel version and the light
+     * transfer functions of channels 1.. (with UMBRA_REBUILD_VOLUME / _LIGHT_TF). */
+    uint64_t volume_version;
+    uint64_t channel_light_tf_id[UMBRA_MAX_CHANNELS];
+    UmbraClip clip;
 } umbra__light_key;
+
+/* How often a renderer has made each of its caches (umbra__renderer_rebuilds, for the tests
+ * that pin down what a change invalidates). */
+typedef struct umbra__rebuilds {
+    uint64_t tables;      /* step-corrected transfer-function tables uploaded (view or light) */
+    uint64_t visibility;  /* brick and sub-cell visibility tables made (view or light) */
+    uint64_t shadow;      /* shadow structures built */
+    uint64_t effective;   /* transfer functions resampled onto a volume's range */
+} umbra__rebuilds;
 
 /* An asynchronous frame (umbra_renderer_render_to_cl_buffer_async), set on the renderer for the
  * duration of that call; NULL during the blocking calls. */
@@ -148,7 +166,9 @@ struct umbra_renderer_t {
     cl_mem view_bricks_buf;                  /* uchar per brick: nonzero if visible (view) */
     cl_mem view_cells_buf, light_cells_buf;  /* ulong per brick: its visible sub-cells; a brick
                                               * is visible if any of them is */
-    uint64_t view_tf_key[3], light_tf_key[3];/* (tf id, volume id, step bits) they were made for */
+    uint64_t view_tf_key[8], light_tf_key[8];/* what they were made for (host/tables.c): each
+                                                channel's tf id, the step, the kind of volume,
+                                                its id and its ranges' version */
     umbra__light_key built;                  /* inputs of the current shadow structure */
     int built_valid;
     umbra__light_key last_key;               /* the full structure's inputs at the last frame
@@ -165,6 +185,19 @@ struct umbra_renderer_t {
      * (tf id, volume id) each was made for. Every technique reads these. */
     umbra_transfer_function view_eff, light_eff;
     uint64_t view_eff_key[2], light_eff_key[2];
+    /* Channels 1.. of a multi-channel volume (umbra_renderer_set_channel_transfer_function; 0
+     * is tf and light_tf above): their transfer functions (light NULL: the view one) and those
+     * in effect over their channel's range (host/channels.c). */
+    umbra_transfer_function ch_tf[UMBRA_MAX_CHANNELS], ch_light_tf[UMBRA_MAX_CHANNELS];
+    umbra_transfer_function ch_view_eff[UMBRA_MAX_CHANNELS], ch_light_eff[UMBRA_MAX_CHANNELS];
+    uint64_t ch_view_eff_key[UMBRA_MAX_CHANNELS][2], ch_light_eff_key[UMBRA_MAX_CHANNELS][2];
+    umbra_clip_desc clip;                    /* umbra_renderer_set_clip's, as given */
+    /* The projection modes' program, kernel and uncorrected view tables (host/projection.c). */
+    cl_program projection_program;
+    cl_kernel projection_kernel;
+    cl_mem projection_tf;
+    uint64_t projection_key[UMBRA_MAX_CHANNELS];
+    umbra__rebuilds rebuilds;
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
@@ -255,6 +288,29 @@ float umbra__voxel_world(umbra_renderer r);
  * render time). Techniques may rely on it during build. */
 void umbra__frame_update_light(umbra_renderer r);
 
+/* Nonzero when every channel's light transfer function in effect is grey (host/channels.c). */
+int umbra__light_tfs_grey(umbra_renderer r);
+
+/* Refuses, naming fn, what the frame cannot render with the renderer's volume, mode and
+ * technique: a channel without a transfer function, a projection mode with a shadow technique
+ * or a label map, a multi-channel volume or label map with a technique without
+ * UMBRA_TECHNIQUE_CHANNELS or with pre-integration (host/channels.c). */
+umbra_status umbra__check_kind(umbra_renderer r, const char *fn);
+
+/* The projection modes (host/projection.c): the kernel for r->opts.mode with every argument
+ * set for a frame into out, and the work-group it runs in; _release frees what they keep. */
+umbra_status umbra__projection_kernel(umbra_renderer r, cl_mem out, cl_kernel *k,
+                                      size_t local[2]);
+void umbra__projection_release(umbra_renderer r);
+
+/* The ray caster's work-group for kernel k: 32 x 8 where the kernel and device allow 256, else
+ * 8 x 8 (host/renderer.c). */
+void umbra__choose_local(umbra_renderer r, cl_kernel k, size_t local[2]);
+
+/* r->shadow_params.clip from the clip region set and the volume's placement (host/clip.c);
+ * called by umbra__frame_update_light. */
+void umbra__clip_update(umbra_renderer r);
+
 /* Makes sure r->light_tf_buf holds the light table (alphas as given: the kernels correct per
  * sample, kernels/common/common.cl) and r->light_cells_buf the visibility of each brick's sub-cells
  * under it. */
@@ -311,12 +367,17 @@ static inline void umbra__release_mem(cl_mem *m)
     *m = NULL;
 }
 
-/* tf's table for step_voxels (0: the light's, uncorrected) into *tf_buf, and, where the buffers
- * are given, the bricks and sub-cells it makes visible; rebuilt only when key (tf id, volume id,
- * step) changes (host/tables.c). */
-umbra_status umbra__tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
-                           uint64_t key[3], cl_mem *tf_buf, cl_mem *bricks_buf,
-                           cl_mem *cells_buf);
+/* The table of tfs (one per channel of the volume) for step_voxels (0: the light's,
+ * uncorrected) into *tf_buf, and, where the buffers are given, the bricks and sub-cells they make
+ * visible; the table is remade only when the transfer functions or the step change, the
+ * visibility also when the volume or its ranges do (key; host/tables.c). Sets the parts of the
+ * frame's UmbraChannels the table's channels take. */
+umbra_status umbra__tables(umbra_renderer r, const umbra_transfer_function *tfs,
+                           float step_voxels, uint64_t key[8], cl_mem *tf_buf,
+                           cl_mem *bricks_buf, cl_mem *cells_buf);
+
+/* The view (light 0) or light transfer functions in effect, one per channel of the volume. */
+void umbra__channel_tfs(umbra_renderer r, int light, umbra_transfer_function *out);
 
 /* The view part of the frame constants for a width x height image (host/frame.c). */
 void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height);

@@ -150,34 +150,53 @@ static uint32_t *visible_prefix(umbra_transfer_function tf)
     return visible;
 }
 
-/* Whether some table entry that values in [minmax[0], minmax[1]] interpolate has alpha > 0. */
+/* Whether some table entry that values in [minmax[0], minmax[1]] interpolate has alpha > 0; for
+ * a label map (labels), whether some label in that range has an entry with alpha > 0 (labels
+ * past the table's end are transparent). */
 static int range_visible(umbra_transfer_function tf, const uint32_t *visible,
-                         const float minmax[2])
+                         const float minmax[2], int labels)
 {
     const float last = (float)(tf->count - 1);
-    int lo = (int)floorf(minmax[0] * last), hi = (int)ceilf(minmax[1] * last);
+    int lo = labels ? (int)minmax[0] : (int)floorf(minmax[0] * last);
+    int hi = labels ? (int)minmax[1] : (int)ceilf(minmax[1] * last);
     lo = lo < 0 ? 0 : lo;
     hi = hi > (int)tf->count - 1 ? (int)tf->count - 1 : hi;
     return hi >= lo && visible[hi + 1] > visible[lo];
 }
 
-/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under tf (visible:
- * visible_prefix's). */
-static umbra_status brick_table(umbra_renderer r, umbra_transfer_function tf,
-                                const uint32_t *visible, cl_mem *buf)
+/* The transfer functions of a table set: each channel's (n of them) and their visibility
+ * prefixes. */
+typedef struct table_set {
+    const umbra_transfer_function *tfs;
+    uint32_t *visible[UMBRA_MAX_CHANNELS];
+    uint32_t n;
+} table_set;
+
+/* Whether brick or sub-cell i (per channel, n_per of them) is visible to some channel. */
+static int set_visible(umbra_renderer r, const table_set *T, const float *minmax, size_t n_per,
+                       size_t i)
+{
+    for (uint32_t c = 0; c < T->n; ++c)
+        if (range_visible(T->tfs[c], T->visible[c], minmax + 2 * (n_per * c + i),
+                          r->volume->labels))
+            return 1;
+    return 0;
+}
+
+/* One byte per brick: 1 if some value in the brick's range has alpha > 0 under the set. */
+static umbra_status brick_table(umbra_renderer r, const table_set *T, cl_mem *buf)
 {
     umbra_volume v = r->volume;
     const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
     unsigned char *flags = malloc(n);
     for (size_t b = 0; flags && b < n; ++b)
-        flags[b] = (unsigned char)range_visible(tf, visible, v->brick_minmax + 2 * b);
+        flags[b] = (unsigned char)set_visible(r, T, v->brick_minmax, n, b);
     return upload_table(r, flags, n, "brick table", buf);
 }
 
 /* One 64-bit mask per brick: bit (x + 4 y + 16 z) set if sub-cell (x, y, z) has a value with
- * alpha > 0 under tf (kernels/common/umbra_shared.h, UMBRA_BRICK_CELLS; visible as above). */
-static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf,
-                               const uint32_t *visible, cl_mem *buf)
+ * alpha > 0 under the set (kernels/common/umbra_shared.h, UMBRA_BRICK_CELLS). */
+static umbra_status cell_table(umbra_renderer r, const table_set *T, cl_mem *buf)
 {
     umbra_volume v = r->volume;
     const size_t n = (size_t)v->brick_counts[0] * v->brick_counts[1] * v->brick_counts[2];
@@ -185,40 +204,104 @@ static umbra_status cell_table(umbra_renderer r, umbra_transfer_function tf,
     uint64_t *masks = calloc(n, sizeof *masks);
     for (size_t b = 0; masks && b < n; ++b)
         for (uint32_t c = 0; c < cells; ++c)
-            if (range_visible(tf, visible, v->cell_minmax + 2 * (b * cells + c)))
+            if (set_visible(r, T, v->cell_minmax, n * cells, b * cells + c))
                 masks[b] |= (uint64_t)1 << c;
     return upload_table(r, masks, n * sizeof *masks, "cell table", buf);
 }
 
-/* The step-corrected table of tf, its cell masks and, with brick_buf, its brick table, kept while
- * tf, the volume and the step stay the same. */
-umbra_status umbra__tables(umbra_renderer r, umbra_transfer_function tf, float step_voxels,
-                           uint64_t key[3], cl_mem *tf_buf, cl_mem *brick_buf, cl_mem *cell_buf)
+/* A multi-channel volume's table: each channel's entries after the previous channel's, alphas
+ * corrected for step_voxels (the light's, 0, as given), at and n giving each part. */
+static umbra_status channel_tables(umbra_renderer r, const table_set *T, float step_voxels,
+                                   uint32_t at[UMBRA_MAX_CHANNELS],
+                                   uint32_t cnt[UMBRA_MAX_CHANNELS], cl_mem *buf)
 {
+    size_t total = 0;
+    for (uint32_t c = 0; c < T->n; ++c)
+        total += T->tfs[c]->count;
+    float *t = malloc(total * 4 * sizeof *t);
+    if (!t)
+        return upload_table(r, NULL, total * 16, "channels' transfer functions", buf);
+    size_t k = 0;
+    for (uint32_t c = 0; c < T->n; ++c) {
+        const umbra_transfer_function tf = T->tfs[c];
+        at[c] = (uint32_t)k;
+        cnt[c] = tf->count;
+        for (uint32_t i = 0; i < tf->count; ++i, ++k) {
+            memcpy(t + 4 * k, tf->rgba + 4 * i, 3 * sizeof(float));
+            double a = tf->rgba[4 * i + 3];
+            t[4 * k + 3] = step_voxels == 0.0f ? (float)a
+                           : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
+                                     : 1.0f;
+        }
+    }
+    return upload_table(r, t, total * 4 * sizeof *t, "channels' transfer functions", buf);
+}
+
+umbra_status umbra__tables(umbra_renderer r, const umbra_transfer_function *tfs,
+                           float step_voxels, uint64_t key[8], cl_mem *tf_buf, cl_mem *brick_buf,
+                           cl_mem *cell_buf)
+{
+    umbra_volume v = r->volume;
+    const uint32_t n = v->channels;
     uint32_t bits;
     memcpy(&bits, &step_voxels, sizeof bits);
-    uint64_t want[3] = {tf->id, r->volume->id, bits};
-    if (*tf_buf && *cell_buf && (!brick_buf || *brick_buf) && memcmp(want, key, sizeof want) == 0)
+    /* What the table depends on (the transfer functions, the step, the kind of volume) and
+     * what the visibility depends on besides (the volume and its ranges). */
+    uint64_t want[8] = {0, 0, 0, 0, bits, (uint64_t)n | (uint64_t)v->labels << 8, v->id,
+                        v->ranges_version};
+    for (uint32_t c = 0; c < n; ++c)
+        want[c] = tfs[c]->id;
+    UmbraChannels *ch = &r->frame.ch;
+    uint32_t *at = step_voxels == 0.0f ? ch->light_at : ch->view_at;
+    uint32_t *cnt = step_voxels == 0.0f ? ch->light_n : ch->view_n;
+    for (uint32_t c = 0; c < UMBRA_MAX_CHANNELS; ++c)
+        at[c] = cnt[c] = 0;
+    uint32_t k = 0;
+    for (uint32_t c = 0; c < n; ++c) {
+        at[c] = k;
+        cnt[c] = tfs[c]->count;
+        k += tfs[c]->count;
+    }
+    const int table = !*tf_buf || memcmp(want, key, 6 * sizeof want[0]) != 0;
+    const int vis = table || !*cell_buf || (brick_buf && !*brick_buf) ||
+                    memcmp(want, key, sizeof want) != 0;
+    if (!vis)
         return UMBRA_SUCCESS;
-    umbra_status st = corrected_table(r, tf, step_voxels, tf_buf);
-    uint32_t *visible = st == UMBRA_SUCCESS ? visible_prefix(tf) : NULL;
-    if (st == UMBRA_SUCCESS && !visible)
-        st = umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                         "umbra_renderer_render: out of memory for the visibility tables");
+    memset(key, 0, 8 * sizeof key[0]);
+    table_set T = {.tfs = tfs, .n = n};
+    umbra_status st = UMBRA_SUCCESS;
+    if (table) {
+        st = n == 1 ? corrected_table(r, tfs[0], step_voxels, tf_buf)
+                    : channel_tables(r, &T, step_voxels, at, cnt, tf_buf);
+        r->rebuilds.tables++;
+    }
+    for (uint32_t c = 0; c < n && st == UMBRA_SUCCESS; ++c)
+        if (!(T.visible[c] = visible_prefix(tfs[c])))
+            st = umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_renderer_render: out of memory for the visibility tables");
     if (st == UMBRA_SUCCESS && brick_buf)
-        st = brick_table(r, tf, visible, brick_buf);
+        st = brick_table(r, &T, brick_buf);
     if (st == UMBRA_SUCCESS)
-        st = cell_table(r, tf, visible, cell_buf);
-    free(visible);
+        st = cell_table(r, &T, cell_buf);
+    for (uint32_t c = 0; c < n; ++c)
+        free(T.visible[c]);
+    r->rebuilds.visibility++;
     if (st == UMBRA_SUCCESS)
         memcpy(key, want, sizeof want);
-    else
-        memset(key, 0, 3 * sizeof key[0]);
     return st;
+}
+
+void umbra__channel_tfs(umbra_renderer r, int light, umbra_transfer_function *out)
+{
+    out[0] = light ? umbra__light_tf(r) : umbra__view_tf(r);
+    for (uint32_t c = 1; c < r->volume->channels; ++c)
+        out[c] = light ? r->ch_light_eff[c] : r->ch_view_eff[c];
 }
 
 umbra_status umbra__light_tables(umbra_renderer r)
 {
-    return umbra__tables(r, umbra__light_tf(r), 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
-                  &r->light_cells_buf);
+    umbra_transfer_function tfs[UMBRA_MAX_CHANNELS];
+    umbra__channel_tfs(r, 1, tfs);
+    return umbra__tables(r, tfs, 0.0f, r->light_tf_key, &r->light_tf_buf, NULL,
+                         &r->light_cells_buf);
 }

@@ -165,27 +165,43 @@ void umbra__ground_plane(umbra_volume v, const float ext[3], float gap, float pl
 umbra_transfer_function umbra__view_tf(umbra_renderer r) { return r->view_eff; }
 umbra_transfer_function umbra__light_tf(umbra_renderer r) { return r->light_eff; }
 
-/* Keeps *eff equal to umbra__tf_for_volume(tf, volume), re-made when either changed. */
-static umbra_status effective_tf(umbra_renderer r, umbra_transfer_function tf,
+/* Keeps *eff equal to umbra__tf_for_volume(tf, channel c's range), re-made when either changed
+ * (a volume's ranges never change: an update keeps them). A label map's table is indexed by
+ * label, whatever data range it was given: it is used as it is. */
+static umbra_status effective_tf(umbra_renderer r, umbra_transfer_function tf, uint32_t c,
                                  umbra_transfer_function *eff, uint64_t key[2])
 {
     const uint64_t want[2] = {tf->id, r->volume->id};
     if (*eff && memcmp(want, key, sizeof want) == 0)
         return UMBRA_SUCCESS;
-    umbra_transfer_function made = NULL;
-    umbra_status st = umbra__tf_for_volume(tf, r->volume->value_min, r->volume->value_max, &made);
+    umbra_transfer_function made = tf;
+    umbra_status st = UMBRA_SUCCESS;
+    if (r->volume->labels)
+        umbra_transfer_function_retain(tf);
+    else
+        st = umbra__tf_for_volume(tf, r->volume->channel_range[c][0],
+                                  r->volume->channel_range[c][1], &made);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra_transfer_function_release(*eff);
     *eff = made;
     memcpy(key, want, sizeof want);
+    r->rebuilds.effective++;
     return UMBRA_SUCCESS;
 }
 
 umbra_status umbra__effective_tfs(umbra_renderer r)
 {
-    umbra_status st = effective_tf(r, r->tf, &r->view_eff, r->view_eff_key);
+    umbra_status st = effective_tf(r, r->tf, 0, &r->view_eff, r->view_eff_key);
     if (st == UMBRA_SUCCESS)
-        st = effective_tf(r, r->light_tf ? r->light_tf : r->tf, &r->light_eff, r->light_eff_key);
+        st = effective_tf(r, r->light_tf ? r->light_tf : r->tf, 0, &r->light_eff,
+                          r->light_eff_key);
+    /* Channels 1.. of a multi-channel volume (umbra__check_channels has found them set). */
+    for (uint32_t c = 1; c < r->volume->channels && st == UMBRA_SUCCESS; ++c) {
+        st = effective_tf(r, r->ch_tf[c], c, &r->ch_view_eff[c], r->ch_view_eff_key[c]);
+        if (st == UMBRA_SUCCESS)
+            st = effective_tf(r, r->ch_light_tf[c] ? r->ch_light_tf[c] : r->ch_tf[c], c,
+                              &r->ch_light_eff[c], r->ch_light_eff_key[c]);
+    }
     return st;
 }

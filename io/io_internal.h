@@ -103,6 +103,12 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
                                      umbra_scalar_type type, const uint32_t dims[3],
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out);
+/* The same for a volume of `channels` interleaved values per voxel, or a label map. */
+umbra_status umbra__volume_from_fill_kind(umbra_context ctx, umbra_volume_fill_fn fill,
+                                          void *user, umbra_scalar_type type,
+                                          const uint32_t dims[3], const float spacing[3],
+                                          const float *origin, const float *directions,
+                                          uint32_t channels, int labels, umbra_volume *out);
 
 /* io/tiff.c and io/dicom.cpp: the stack readers behind umbra_volume_load_tiff and
  * umbra_volume_load_dicom, on count files (count 1: one file; never a directory, io/series.c

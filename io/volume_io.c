@@ -269,6 +269,7 @@ void umbra_raw_desc_init(umbra_raw_desc *desc)
     desc->spacing[0] = desc->spacing[1] = desc->spacing[2] = 1.0f;
     desc->big_endian = 0;
     desc->header_bytes = 0;
+    desc->channels = 1;
 }
 
 /* What the raw reader's fill callback reads: the rest of f (path), byte-swapped if need be. */
@@ -294,9 +295,21 @@ umbra_status umbra__volume_from_fill(umbra_context ctx, umbra_volume_fill_fn fil
                                      const float spacing[3], const float *origin,
                                      const float *directions, umbra_volume *out)
 {
+    return umbra__volume_from_fill_kind(ctx, fill, user, type, dims, spacing, origin, directions,
+                                        1, 0, out);
+}
+
+umbra_status umbra__volume_from_fill_kind(umbra_context ctx, umbra_volume_fill_fn fill,
+                                          void *user, umbra_scalar_type type,
+                                          const uint32_t dims[3], const float spacing[3],
+                                          const float *origin, const float *directions,
+                                          uint32_t channels, int labels, umbra_volume *out)
+{
     umbra_volume_desc vd;
     umbra_volume_desc_init(&vd);
     vd.type = type;
+    vd.channels = channels;
+    vd.labels = labels;
     memcpy(vd.dims, dims, sizeof vd.dims);
     memcpy(vd.spacing, spacing, sizeof vd.spacing);
     if (origin && directions) {
@@ -326,6 +339,12 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
                          func, (int)desc->type);
         goto fail;
     }
+    if (desc->channels < 1 || desc->channels > UMBRA_MAX_CHANNELS) {
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: channels %u must lie in [1, %d] (UMBRA_MAX_CHANNELS)", func,
+                         desc->channels, UMBRA_MAX_CHANNELS);
+        goto fail;
+    }
     count = 1;
     for (i = 0; i < 3; ++i) {
         if (desc->dims[i] == 0) {
@@ -334,13 +353,15 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
                              desc->dims[0], desc->dims[1], desc->dims[2]);
             goto fail;
         }
-        if (count > SIZE_MAX / desc->dims[i]) {
+        if (count > SIZE_MAX / desc->dims[i] / (i == 2 ? desc->channels : 1)) {
             st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                              "%s: dims %u x %u x %u: too many voxels", func, desc->dims[0],
                              desc->dims[1], desc->dims[2]);
             goto fail;
         }
         count *= desc->dims[i];
+        if (i == 2)
+            count *= desc->channels;
         if (!(desc->spacing[i] > 0.0f) || !isfinite(desc->spacing[i])) {
             st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                              "%s: spacing %g x %g x %g: each must be finite and > 0", func,
@@ -368,9 +389,10 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     if (file_size != expected) {
         st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
                          "%s: \"%s\" holds %zu bytes, expected %zu (%zu header bytes + "
-                         "%u x %u x %u voxels of %zu bytes)",
+                         "%u x %u x %u voxels of %zu bytes%s)",
                          func, path, file_size, expected, desc->header_bytes, desc->dims[0],
-                         desc->dims[1], desc->dims[2], type_size);
+                         desc->dims[1], desc->dims[2], type_size * desc->channels,
+                         desc->channels > 1 ? ", the channels interleaved" : "");
         goto fail;
     }
     if (desc->header_bytes > 0 && fseeko(f, (off_t)desc->header_bytes, SEEK_SET) != 0) {
@@ -381,8 +403,8 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     }
     raw_fill rf = {ctx, func, path, f, count, type_size,
                    type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()};
-    st = umbra__volume_from_fill(ctx, fill_raw, &rf, desc->type, desc->dims, desc->spacing, NULL,
-                                 NULL, out);
+    st = umbra__volume_from_fill_kind(ctx, fill_raw, &rf, desc->type, desc->dims, desc->spacing,
+                                      NULL, NULL, desc->channels, desc->labels, out);
 
 fail:
     if (f) {
@@ -407,12 +429,17 @@ umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const um
     if (!desc) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", __func__);
     }
-    if (desc->struct_size != sizeof(umbra_raw_desc)) {
+    if (desc->struct_size != sizeof(umbra_raw_desc) &&
+        desc->struct_size != offsetof(umbra_raw_desc, channels)) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: desc->struct_size is %zu, expected %zu (call umbra_raw_desc_init)",
                            __func__, desc->struct_size, sizeof(umbra_raw_desc));
     }
-    return load_raw(ctx, __func__, path, NULL, 0, desc, out);
+    umbra_raw_desc d;
+    umbra_raw_desc_init(&d);
+    memcpy(&d, desc, desc->struct_size);
+    d.struct_size = sizeof d;
+    return load_raw(ctx, __func__, path, NULL, 0, &d, out);
 }
 
 /* ---- Voreen .dat ------------------------------------------------------------------------ */

@@ -11,15 +11,6 @@
  * sample's light at once, where the kernel takes it one sample late: the same arithmetic in the
  * same order per pixel, see the sample loop). */
 
-#if defined(cl_khr_int64_base_atomics)
-#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
-#define UMBRA_COUNT_T ulong
-#define UMBRA_COUNT_ADD(p, v) atom_add((p), (ulong)(v))
-#else
-#define UMBRA_COUNT_T uint
-#define UMBRA_COUNT_ADD(p, v) atomic_add((p), (uint)(v))
-#endif
-
 /* Light arriving at a sample of colour c (alpha ignored) with shadow factor s. l_ray and hv_ray
  * are the direction to a directional light and the half vector, the same for every sample of a
  * ray, so the ray computes them once (shade_ray_light); a point light's are taken at p. The
@@ -87,20 +78,6 @@ inline float3 shadow_point(float3 p, float3 d, float h, float a)
     return p + (h * (emission_depth(a) - 0.5f * (1.0f + a))) * d;
 }
 
-/* The view ray through pixel (px, py): origin and unit direction. */
-inline void camera_ray(__global const UmbraFrame *F, int px, int py, float3 *o, float3 *d)
-{
-    float sx = ((float)px + 0.5f) / (float)F->width * 2.0f - 1.0f;
-    float sy = 1.0f - ((float)py + 0.5f) / (float)F->height * 2.0f;
-    if (F->flags & UMBRA_FLAG_ORTHO) {
-        *o = F3(F->eye) + sx * F3(F->right) + sy * F3(F->up);
-        *d = F3(F->forward);
-    } else {
-        *o = F3(F->eye);
-        *d = normalize(F3(F->forward) + sx * F3(F->right) + sy * F3(F->up));
-    }
-}
-
 __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const float4 *view_tf, __global const float4 *light_tf,
                              __global const uchar *view_bricks, __global const ulong *light_cells,
@@ -141,10 +118,14 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         shade_ray_light(F, d, &l_ray, &hv_ray);
     float2 tb = ray_box(o, d, g.box_min, g.box_max);
     float t0 = fmax(tb.x, 0.0f);
-    float t1 = fmin(tb.y, t_ground);
+    /* The clip region's part of the ray (tb unless something is clipped), sampled on the
+     * unclipped ray's grid: from its first sample k0 on, up to t1. */
+    const float2 tc = clip_interval(&S->clip, o, d, tb);
+    float t1 = fmin(tc.y, t_ground);
     if (t1 > t0) {
         const float h = F->step;
         const float jitter = (flags & UMBRA_FLAG_JITTER) ? umbra_random(F->seed, px, py, 0u) : 0.0f;
+        const int k0 = clip_first_sample(t0, h, jitter, tc.x);
         const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         /* At most UMBRA_MAX_RAY_SAMPLES + 1: the host refuses steps that would take more along
          * the box's diagonal (host/renderer.c, check_ray_samples), so this fits an int. */
@@ -165,7 +146,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
          * segment entering a visible brick is kept; samples before t_visible lie in a brick
          * already found visible. */
         const int walk_cells = skip && !preint_size;
-        CellWalk w = walk_begin(g, o, d, t0);
+        CellWalk w = walk_begin(g, o, d, fmax(t0, tc.x));
         float t_cell = -UMBRA_INF;
         float t_visible = -UMBRA_INF;
         /* A visible sample's light (its shadow lookup, gradient and shading) is taken one
@@ -188,7 +169,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         float3 p_pend = (float3)(0.0f), l_pend = (float3)(0.0f);
         float4 c_pend = (float4)(0.0f);
         float w_pend = 0.0f;
-        for (int k = 0;;) {
+        for (int k = k0;;) {
             int more = k < n;
             float t = 0.0f;
             if (more) {
@@ -220,12 +201,16 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                     c = preint_lookup(preint, preint_size, sf, s_back);
                     c.xyz = preint_color(c);
                 } else {
+#if UMBRA_LABELS || UMBRA_CHANNELS > 1
+                    c = view_sample(F, vol, g, view_tf, F->tf_size, p);
+#else
                     c = tf_classify(view_tf, tm, sample_stored(vol, g, xo + t * xd));
+#endif
                 }
             }
             if (pending) {
                 float3 s = SHADOW_FACTOR(sr, l_pend);
-                float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p_pend)
+                float3 grad = (flags & UMBRA_FLAG_SHADING) ? view_gradient(F, vol, g, view_tf, p_pend)
                                                             : (float3)(0.0f);
                 float3 lit = shade_sample(F, c_pend.xyz, s, p_pend, -d, grad, l_ray, hv_ray);
                 color += w_pend * lit;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_util.c: see test_util.h. */
 #define _POSIX_C_SOURCE 200809L
-#include "internal.h" /* test_read_voxels reads the volume's device copy */
+#include "renderer_internal.h" /* test_read_voxels reads the volume's device copy;
+                                 test_render_image the renderer's context */
 #include "conformance.h"
 #include "test_util.h"
 
@@ -270,4 +271,27 @@ void test_cli_renders_with_named_preset(umbra_context ctx, const char *volume,
         assert_true(fabsf(centre[0] - corner[0]) + fabsf(centre[2] - corner[2]) > 0.05f);
     }
     free(rgba);
+}
+
+float *test_render_image(umbra_renderer r, uint32_t w, uint32_t h)
+{
+    float *img = malloc((size_t)w * h * 4 * sizeof *img);
+    assert_non_null(img);
+    if (umbra_renderer_render(r, w, h, img) != UMBRA_SUCCESS)
+        fail_msg("render: %s", umbra_context_last_message(r->ctx));
+    return img;
+}
+
+float test_max_diff(const float *a, const float *b, size_t n, double *mean)
+{
+    float m = 0.0f;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const float e = fabsf(a[i] - b[i]);
+        m = e > m ? e : m;
+        sum += e;
+    }
+    if (mean)
+        *mean = sum / (double)n;
+    return m;
 }

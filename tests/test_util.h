@@ -93,4 +93,11 @@ umbra_transfer_function test_constant_tf(umbra_context ctx, float grey, float al
 void test_cli_renders_with_named_preset(umbra_context ctx, const char *volume,
                                         const char *out_name);
 
+/* A w x h render of r into a new image (free it), failing the test with the context's message
+ * where the render fails. */
+float *test_render_image(umbra_renderer r, uint32_t w, uint32_t h);
+
+/* The largest |a[i] - b[i]| over n floats, and their mean into *mean where mean is not NULL. */
+float test_max_diff(const float *a, const float *b, size_t n, double *mean);
+
 #endif

@@ -246,10 +246,11 @@ static umbra_status ensure_state(umbra_renderer r, uint32_t w, uint32_t h)
     }
     char options[256];
     umbra__build_options(r, options, sizeof options);
-    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/preintegration.cl",
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/channels.cl",
+                           "common/preintegration.cl",
                            "techniques/convolution.cl"};
     cl_program program;
-    if ((st = umbra__program_get(ctx, files, 4, options, &program)) != UMBRA_SUCCESS)
+    if ((st = umbra__program_get(ctx, files, 5, options, &program)) != UMBRA_SUCCESS)
         return st;
     if (program != s->program) {
         if (s->slice)
@@ -489,7 +490,7 @@ const umbra__technique umbra__technique_convolution = {
         .doc = "Renders the frame itself in view-aligned slices front to back, carrying the "
                "light from slice to slice through a blur kernel: soft shadows at the cost of a "
                "kernel launch per slice every frame, for lights on the viewer's side only.",
-        .flags = UMBRA_TECHNIQUE_FRAME,
+        .flags = UMBRA_TECHNIQUE_FRAME | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
     },
@@ -544,9 +545,10 @@ umbra_status umbra__convolution_subsample_weights(umbra_context ctx, uint32_t n,
     cl_kernel k = NULL;
     cl_mem buf = NULL;
     cl_program program;
-    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/preintegration.cl",
+    const char *files[] = {"common/common.cl", "common/sampling.cl", "common/channels.cl",
+                           "common/preintegration.cl",
                            "techniques/convolution.cl"};
-    if ((st = umbra__program_get(ctx, files, 4, "", &program)) != UMBRA_SUCCESS)
+    if ((st = umbra__program_get(ctx, files, 5, "", &program)) != UMBRA_SUCCESS)
         return st;
     if ((st = umbra__kernel_create(ctx, program, "convolution_subsample_weights", &k)))
         return st;

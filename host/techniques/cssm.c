@@ -110,7 +110,7 @@ const umbra__technique umbra__technique_cssm = {
                "optical-depth threshold is stopped, per light channel: coloured, translucent "
                "shadows in 4 or 12 bytes per texel, at the price of noise that the taps "
                "average.",
-        .flags = UMBRA_TECHNIQUE_MAP,
+        .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* The lookup averages taps fixed in texels (radius 4 for 13 taps): at one texel per

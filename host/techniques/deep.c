@@ -119,9 +119,10 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
     static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/channels.cl",
                                          "common/lightspace.cl"};
     const char *files[8];
-    const size_t nfiles = umbra__program_files(r->tech, common, 3, "techniques/deep_budget.cl",
+    const size_t nfiles = umbra__program_files(r->tech, common, 4, "techniques/deep_budget.cl",
                                                files, 8);
     char options[300];
     cl_program program;
@@ -398,7 +399,9 @@ static umbra_status deep_build(umbra_renderer r, double *ms)
     s->block_bytes = (size_t)d->block_size * s->tile * s->tile * s->node_bytes;
     if (!s->dummy && (st = create_buffer(ctx, 16, "placeholder", &s->dummy)) != UMBRA_SUCCESS)
         return st;
-    s->lut_used = d->lookup_table != 0;
+    /* The segment table integrates one transfer function over pairs of values: a multi-channel
+     * volume or a label map marches the midpoint rule, as lookup_table 0 does. */
+    s->lut_used = d->lookup_table != 0 && r->volume->channels == 1 && !r->volume->labels;
     if (s->lut_used) {
         if ((st = ensure_lut(r, s, ms)) != UMBRA_SUCCESS)
             return st;
@@ -567,7 +570,7 @@ const umbra__technique umbra__technique_deep = {
                "piecewise-linear function compressed within epsilon, per light channel: close "
                "to the reference on translucent and coloured material; memory grows with the "
                "function's nodes (or is fixed by a node budget).",
-        .flags = UMBRA_TECHNIQUE_MAP,
+        .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* A nearest-texel lookup: its error keeps falling with the size; two texels per voxel

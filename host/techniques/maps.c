@@ -49,9 +49,10 @@ umbra_status umbra__map_build(umbra_renderer r, double *ms)
     /* The technique's files without the ray caster: the build kernel needs only the volume
      * access and the projection. Built once per context and options (the context caches it). */
     static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/channels.cl",
                                          "common/lightspace.cl"};
     const char *files[16];
-    size_t nfiles = umbra__program_files(r->tech, common, 3, NULL, files, 16);
+    size_t nfiles = umbra__program_files(r->tech, common, 4, NULL, files, 16);
     char options[256];
     cl_program program;
     umbra__build_options(r, options, sizeof options);

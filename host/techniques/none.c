@@ -12,7 +12,7 @@ const umbra__technique umbra__technique_none = {
         .title = "no shadows",
         .doc = "Shadow factor 1 everywhere: the unshadowed frame every overhead is measured "
                "against.",
-        .flags = UMBRA_TECHNIQUE_NO_LIGHT,
+        .flags = UMBRA_TECHNIQUE_NO_LIGHT | UMBRA_TECHNIQUE_CHANNELS,
     },
     .kernel_files = kernel_files,
 };

@@ -32,7 +32,7 @@ const umbra__technique umbra__technique_reference = {
         .doc = "A shadow ray marched toward the light from every sample, the shading model's "
                "optical depth integrated along it: exact up to its step, and the yardstick of "
                "every other technique; slow (a ray per sample).",
-        .flags = UMBRA_TECHNIQUE_SHADOW_RAYS,
+        .flags = UMBRA_TECHNIQUE_SHADOW_RAYS | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
     },

@@ -97,7 +97,7 @@ const umbra__technique umbra__technique_threshold = {
                "over the taps. Fast and small (4 bytes per texel), but grey and hard: it ignores "
                "the transmission colour and turns translucent material's partial shadows into "
                "full ones.",
-        .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_GREY,
+        .flags = UMBRA_TECHNIQUE_MAP | UMBRA_TECHNIQUE_GREY | UMBRA_TECHNIQUE_CHANNELS,
         .rebuilt_by = UMBRA_REBUILD_LIGHT_PASS,
         .param_count = sizeof params / sizeof params[0],
         /* One depth per texel: a texel per voxel resolves what the volume holds (finer maps

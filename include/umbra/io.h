@@ -145,12 +145,17 @@ UMBRA_API umbra_status umbra_volume_load_tiff(umbra_context ctx, const char *con
                                               size_t count, umbra_volume *out);
 
 typedef struct umbra_raw_desc {
-    size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init */
+    size_t struct_size;      /* sizeof(umbra_raw_desc); set by umbra_raw_desc_init (the layout
+                                before channels, offsetof(umbra_raw_desc, channels), is accepted
+                                with one channel and no labels) */
     umbra_scalar_type type;
     uint32_t dims[3];
     float spacing[3];        /* default 1 */
     int big_endian;          /* 0 (default): little-endian */
     size_t header_bytes;     /* bytes to skip at the start of the file (default 0) */
+    uint32_t channels;       /* values per voxel, interleaved (umbra_volume_desc.channels;
+                                default 1) */
+    int labels;              /* nonzero: the voxels are labels (umbra_volume_desc.labels) */
 } umbra_raw_desc;
 
 /* Fills desc with the defaults (struct_size included); NULL is a no-op. */

@@ -76,6 +76,10 @@ typedef struct umbra_param_info {
 #define UMBRA_TECHNIQUE_SHADOW_RAYS 16u /* marches a shadow ray from every view sample and query
                                          point (reference): each costs up to the box diagonal
                                          over its light step in samples */
+#define UMBRA_TECHNIQUE_CHANNELS 32u /* renders multi-channel volumes and label maps (its light
+                                        pass reads the light through the shared per-point
+                                        lookup); a technique without it refuses them at render
+                                        with UMBRA_ERROR_UNSUPPORTED */
 
 /* umbra_technique_info.rebuilt_by: the renderer's inputs whose change rebuilds the technique's
  * shadow structure (beside its parameters flagged UMBRA_PARAM_REBUILDS; a camera move never
@@ -85,10 +89,11 @@ typedef struct umbra_param_info {
 #define UMBRA_REBUILD_VOLUME 4u       /* umbra_renderer_set_volume */
 #define UMBRA_REBUILD_TRANSMISSION 8u /* umbra_render_desc.transmission */
 #define UMBRA_REBUILD_SKIPPING 16u    /* umbra_render_desc.empty_space_skipping */
+#define UMBRA_REBUILD_CLIP 32u        /* umbra_renderer_set_clip */
 /* All of them: a structure built from the light pass. */
 #define UMBRA_REBUILD_LIGHT_PASS                                                               \
     (UMBRA_REBUILD_LIGHT | UMBRA_REBUILD_LIGHT_TF | UMBRA_REBUILD_VOLUME |                     \
-     UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING)
+     UMBRA_REBUILD_TRANSMISSION | UMBRA_REBUILD_SKIPPING | UMBRA_REBUILD_CLIP)
 
 typedef struct umbra_technique_info {
     umbra_shadow_technique id;

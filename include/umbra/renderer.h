@@ -112,6 +112,26 @@ typedef enum umbra_interaction {
     UMBRA_INTERACTION_AUTO = 1
 } umbra_interaction;
 
+/* How a frame turns samples into pixels (umbra_render_desc.mode). The projection modes take
+ * the volume's normalised value at the view ray's samples (the composite mode's positions:
+ * every step inside the volume's box and the clip region, jittered when jitter is set, no
+ * empty-space skipping or early termination) and reduce them to one value m per pixel: the
+ * largest (MIP), the smallest (MinIP) or their mean (average intensity projection). The pixel is
+ * the view transfer function's entry at m, alpha as given (not corrected for the step),
+ * premultiplied and over the background: (rgb a, a) + (1 - a) background; a ray that meets no
+ * sample shows the background. A volume of several channels projects each channel through its
+ * own transfer function and adds the premultiplied colours, alpha 1 - prod (1 - a_c) (additive
+ * blending, as microscopy viewers show channels). They draw no light: shadows, shading, the
+ * ground plane, transmission, termination and pre-integration do not apply, and a shadow
+ * technique other than UMBRA_SHADOW_NONE, or a label map (labels have no order), is refused at
+ * render with UMBRA_ERROR_INVALID_ARGUMENT naming the mode. */
+typedef enum umbra_render_mode {
+    UMBRA_RENDER_COMPOSITE = 0, /* emission-absorption compositing, lit and shadowed (default) */
+    UMBRA_RENDER_MIP = 1,       /* maximum intensity projection */
+    UMBRA_RENDER_MINIP = 2,     /* minimum intensity projection */
+    UMBRA_RENDER_AVERAGE = 3    /* average intensity projection */
+} umbra_render_mode;
+
 typedef struct umbra_render_desc {
     size_t struct_size;      /* sizeof(umbra_render_desc); set by umbra_render_desc_init */
     float step;              /* sampling step along view rays, in voxels (default 0.5) */
@@ -141,13 +161,12 @@ typedef struct umbra_render_desc {
                                 segments of length `step`, and the convolution technique
                                 attenuates the light with the segment's pre-integrated
                                 transmittance (default 0) */
-    /* Fields below were added after umbra 0.5.0; a desc whose struct_size is that layout's size
-     * (it ended with preintegrated) is accepted and leaves them as they were. */
+    /* Added after umbra 0.5: a desc of that layout's size (RENDER_DESC_SIZE_0_5 in
+     * host/renderer.c, or offsetof(umbra_render_desc, mode) without its padding) is accepted and
+     * leaves the fields below as they were. */
+    umbra_render_mode mode;  /* default UMBRA_RENDER_COMPOSITE */
     umbra_interaction interaction; /* UMBRA_INTERACTION_OFF (default) or _AUTO: progressive
-                                      shadows, below */
-    uint32_t reserved;       /* 0 (umbra_render_desc_init); unread. Without it this layout would
-                                have the size of umbra 0.5.0's, which struct_size must tell
-                                apart */
+                                      shadows, above */
 } umbra_render_desc;
 
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
@@ -245,6 +264,55 @@ UMBRA_API umbra_status umbra_renderer_set_camera(umbra_renderer r, const umbra_c
 UMBRA_API umbra_status umbra_renderer_set_light(umbra_renderer r, const umbra_light *light);
 UMBRA_API umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_desc *desc);
 UMBRA_API umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc *desc);
+
+/* The transfer functions of channel `channel` of a multi-channel volume (volume.h; channel 0's
+ * are the ones set above, which this call sets too for channel 0): tf, its view transfer
+ * function (retained; NULL is refused), and light_tf, its light transfer function (retained;
+ * NULL: tf). Each is resampled onto its channel's value range as a single volume's is. The
+ * channels mix as emission-absorption media do (docs/features.md): at a sample their
+ * extinctions -ln(1 - a_c) add, so the opacity is 1 - prod (1 - a_c), and the colour is the
+ * channels' colours weighted by their extinctions; the light is absorbed by the summed
+ * extinction, each channel's through its own transmission colour, so shadows take the colour of
+ * what casts them. A channel without a transfer function of its own is refused at render
+ * (UMBRA_ERROR_INVALID_ARGUMENT naming it). channel lies in [0, UMBRA_MAX_CHANNELS). */
+UMBRA_API umbra_status umbra_renderer_set_channel_transfer_function(umbra_renderer r,
+                                                                    uint32_t channel,
+                                                                    umbra_transfer_function tf,
+                                                                    umbra_transfer_function light_tf);
+
+/* Clipping: up to UMBRA_MAX_CLIP_PLANES planes and a crop box cut the volume to the convex
+ * region they all keep, for the view and the light alike: what is clipped away is neither seen
+ * nor casts a shadow, in every shadow technique (each light ray, shadow ray and convolution
+ * slice sees the same region) and in the projection modes. A view ray takes the samples it would
+ * take without clipping that lie inside the region (none move), so moving a plane does not shift
+ * the sampling of what stays. The ground plane is not clipped, and empty-space skipping is
+ * unchanged (the clip applies on top of it). A change rebuilds the shadow structure, not the
+ * view tables. With nothing clipped (the default) a frame costs what it did before clipping
+ * existed (docs/features.md). */
+#define UMBRA_MAX_CLIP_PLANES 6
+typedef struct umbra_clip_desc {
+    size_t struct_size;      /* sizeof(umbra_clip_desc); set by umbra_clip_desc_init */
+    uint32_t plane_count;    /* planes in use, 0 (default) to UMBRA_MAX_CLIP_PLANES */
+    float planes[UMBRA_MAX_CLIP_PLANES][4]; /* plane i, (a, b, c, d) in the volume's world,
+                                keeps the points with a x + b y + c z + d >= 0; finite, (a, b, c)
+                                not zero, and the plane within UMBRA_MAX_COORDINATE of the
+                                origin (|d| / |(a, b, c)|) */
+    int crop;                /* nonzero: keep only the crop box too (default 0) */
+    float crop_min[3], crop_max[3]; /* the crop box in voxel coordinates, voxel (i, j, k)'s centre
+                                at (i, j, k), so [-0.5, dims - 0.5] is the whole volume
+                                (umbra_clip_desc_init sets 0; read only with crop): finite,
+                                min <= max per axis */
+} umbra_clip_desc;
+
+/* Fills desc with the defaults beside each field (nothing clipped; struct_size included); NULL
+ * is a no-op. */
+UMBRA_API void umbra_clip_desc_init(umbra_clip_desc *desc);
+
+/* Copies and validates the clip region (NULL: nothing clipped). A bad value is refused with
+ * UMBRA_ERROR_INVALID_ARGUMENT naming the plane or axis and the value, and changes nothing. The
+ * crop box is in voxels and follows the volume; the planes are in the world and stay there when
+ * the volume changes. */
+UMBRA_API umbra_status umbra_renderer_set_clip(umbra_renderer r, const umbra_clip_desc *desc);
 
 /* Renders width x height premultiplied RGBA floats, row 0 at the top, into rgba (4*w*h floats,
  * borrowed). Blocks until done. */

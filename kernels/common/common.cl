@@ -1,10 +1,21 @@
 // SPDX-License-Identifier: Apache-2.0
-/* kernels/common/common.cl: math shared by every umbra program: ray-box intersection,
- * transfer-function
- * lookup, the counter-based random numbers, and the brick walk used for empty-space skipping.
+/* kernels/common/common.cl: math shared by every umbra program: ray-box intersection, the clip
+ * region, transfer-function lookup, the counter-based random numbers, and the brick walk used
+ * for empty-space skipping.
  * It follows common/umbra_shared.h and precedes common/sampling.cl in every program. */
 
 #define UMBRA_INF INFINITY
+
+/* The counter of samples a frame takes (umbra_render_stats.samples): 64-bit where the device has
+ * the atomics. */
+#if defined(cl_khr_int64_base_atomics)
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+#define UMBRA_COUNT_T ulong
+#define UMBRA_COUNT_ADD(p, v) atom_add((p), (ulong)(v))
+#else
+#define UMBRA_COUNT_T uint
+#define UMBRA_COUNT_ADD(p, v) atomic_add((p), (uint)(v))
+#endif
 
 /* For functions of the ray loops that the compiler would otherwise call out of line (PoCL did,
  * copying VolGeom on every call). */
@@ -56,6 +67,59 @@ inline float2 ray_box(float3 o, float3 d, float3 bmin, float3 bmax)
     float t0 = fmax(fmax(tmin.x, tmin.y), tmin.z);
     float t1 = fmin(fmin(tmax.x, tmax.y), tmax.z);
     return (float2)(t0, t1);
+}
+
+/* ---- the clip region (UmbraClip, kernels/common/umbra_shared.h) --------------------------------
+ * One mechanism for every ray: the region is convex, so a ray crosses it in one interval, which
+ * the view rays, the light-space maps' light rays (ls_texel_ray) and the reference's shadow rays
+ * take in place of their interval in the volume's box; the convolution technique's slices test
+ * each sample (clip_keeps). Nothing is read past `active` when nothing is clipped. */
+
+/* The part of the interval tb (a ray's part in the volume's box, from ray_box) of the ray o + t d
+ * that the clip region keeps: empty (.y < .x, or .y = -inf) where the ray misses it. */
+inline float2 clip_interval(__global const UmbraClip *C, float3 o, float3 d, float2 tb)
+{
+    if (!C->active)
+        return tb;
+    const float2 tc = ray_box(o, d, F3(C->box_min), F3(C->box_max));
+    float2 t = (float2)(fmax(tb.x, tc.x), fmin(tb.y, tc.y));
+    for (uint i = 0; i < C->plane_count; ++i) {
+        const float3 n = F3(C->planes[i]);
+        const float dn = dot(n, d), s = dot(n, o) + C->planes[i][3];
+        /* Kept where s + t dn >= 0: from -s / dn on when dn > 0, up to it when dn < 0, and
+         * everywhere or nowhere on a ray parallel to the plane. */
+        if (dn > 0.0f)
+            t.x = fmax(t.x, -s / dn);
+        else if (dn < 0.0f)
+            t.y = fmin(t.y, -s / dn);
+        else if (s < 0.0f)
+            t.y = -UMBRA_INF;
+    }
+    return t;
+}
+
+/* Whether the clip region keeps point p. */
+inline int clip_keeps(__global const UmbraClip *C, float3 p)
+{
+    if (!C->active)
+        return 1;
+    if (any(p < F3(C->box_min)) || any(p > F3(C->box_max)))
+        return 0;
+    for (uint i = 0; i < C->plane_count; ++i)
+        if (dot(F3(C->planes[i]), p) + C->planes[i][3] < 0.0f)
+            return 0;
+    return 1;
+}
+
+/* The first sample index k >= 0 of a ray sampled at t0 + (k + offset) h that lies at or after
+ * t_from: the clipped interval's first sample, on the same grid as the unclipped ray's, so that
+ * clipping drops samples and moves none (a clip plane moving through the volume does not shift
+ * the sampling of what it keeps). 0 where t_from <= t0. */
+inline int clip_first_sample(float t0, float h, float offset, float t_from)
+{
+    if (!(t_from > t0))
+        return 0;
+    return (int)fmin(ceil((t_from - t0) / h - offset), 2147483000.0f);
 }
 
 /* Linear interpolation in an RGBA table spread over [0,1]. */
@@ -355,6 +419,20 @@ inline float brick_exit(VolGeom g, float3 o, float3 d, float t_now)
     float3 t = select(t_lo, t_hi, d > 0.0f);
     t = select(t, (float3)(UMBRA_INF), d == 0.0f);
     return fmin(fmin(t.x, t.y), t.z);
+}
+
+/* The view ray through pixel (px, py): origin and unit direction. */
+inline void camera_ray(__global const UmbraFrame *F, int px, int py, float3 *o, float3 *d)
+{
+    float sx = ((float)px + 0.5f) / (float)F->width * 2.0f - 1.0f;
+    float sy = 1.0f - ((float)py + 0.5f) / (float)F->height * 2.0f;
+    if (F->flags & UMBRA_FLAG_ORTHO) {
+        *o = F3(F->eye) + sx * F3(F->right) + sy * F3(F->up);
+        *d = F3(F->forward);
+    } else {
+        *o = F3(F->eye);
+        *d = normalize(F3(F->forward) + sx * F3(F->right) + sy * F3(F->up));
+    }
 }
 
 /* Direction towards the light and the distance to it (infinite for a directional light). */

@@ -52,7 +52,8 @@ UMBRA_INLINE float3 ls_world_to_map(__global const UmbraShadow *S, float3 p)
 }
 
 /* The light ray through map position (x, y) in texels: origin o, unit direction d, and the
- * parameter interval [t.x, t.y] where it crosses the volume's box (empty if t.y <= t.x). Depth at
+ * parameter interval [t.x, t.y] where it crosses the volume's box and the clip region (empty if
+ * t.y <= t.x). Depth at
  * parameter t is ls_depth(S, o, t). */
 inline float2 ls_texel_ray(__global const UmbraShadow *S, VolGeom g, float2 xy, float3 *o, float3 *d)
 {
@@ -71,7 +72,8 @@ inline float2 ls_texel_ray(__global const UmbraShadow *S, VolGeom g, float2 xy, 
             *d = l.x * u + l.y * v + l.z * w;
         }
     }
-    float2 t = ray_box(*o, *d, g.box_min, g.box_max);
+    /* The clip region's part: a clipped region casts no shadow in any map. */
+    float2 t = clip_interval(&S->clip, *o, *d, ray_box(*o, *d, g.box_min, g.box_max));
     t.x = fmax(t.x, 0.0f);
     return t;
 }

@@ -33,6 +33,23 @@ typedef int int32_t;
 #define UMBRA_FLAG_COLORED 32u
 #define UMBRA_FLAG_POINT_LIGHT 64u
 
+/* A volume of several channels, or a label map (kernels/common/channels.cl; host/channels.c
+ * fills it). Channel c's voxels follow channel c - 1's in the one volume buffer, each channel
+ * dims[0] dims[1] dims[2] voxels and a pad element long, normalised through its own value map
+ * (UmbraFrame.value_map's three numbers); its view and light tables are entries [at, at + n) of
+ * the view and light tables. A label map is one channel whose voxels are labels: entry l of the
+ * tables is label l's colour and opacity, labels at or past n are transparent. count 1, labels
+ * 0: a plain volume, which reads none of this. */
+#define UMBRA_MAX_CHANNELS 4
+typedef struct UmbraChannels {
+    float value_map[UMBRA_MAX_CHANNELS][4];
+    uint32_t view_at[UMBRA_MAX_CHANNELS], view_n[UMBRA_MAX_CHANNELS];
+    uint32_t light_at[UMBRA_MAX_CHANNELS], light_n[UMBRA_MAX_CHANNELS];
+    uint32_t count;        /* channels, 1 to UMBRA_MAX_CHANNELS */
+    uint32_t labels;       /* 1: a label map */
+    uint32_t pad[2];
+} UmbraChannels;
+
 /* Everything one view-space frame needs: camera, volume geometry, light and shading. World space
  * has the volume's box centred on the origin; "voxel coordinates" put voxel i's centre at i. */
 typedef struct UmbraFrame {
@@ -61,7 +78,23 @@ typedef struct UmbraFrame {
     float termination;     /* early ray termination threshold on accumulated opacity */
     float kd, ks, shininess;
     uint32_t tf_size, light_tf_size;
+    UmbraChannels ch;      /* a multi-channel volume's channels, or a label map */
 } UmbraFrame;
+
+/* The clip region (umbra_renderer_set_clip, filled by host/clip.c in the volume's local frame):
+ * the points inside the crop box [box_min, box_max] (the volume's box when no crop box is set)
+ * and on the kept side n.p + w >= 0 of each of the plane_count planes (n, w), n unit: a convex
+ * region, so every ray crosses it in one interval (clip_interval, kernels/common/common.cl). View
+ * rays, every light ray and shadow ray and the convolution technique's slices read it: a clipped
+ * region is neither seen nor casts a shadow. active 0 (nothing clipped) skips it all. */
+#define UMBRA_CLIP_PLANES 6
+typedef struct UmbraClip {
+    float box_min[4], box_max[4];
+    float planes[UMBRA_CLIP_PLANES][4];
+    uint32_t active;
+    uint32_t plane_count;
+    uint32_t pad[2];
+} UmbraClip;
 
 /* Light-space map projections (UmbraShadow.ls_mode). */
 #define UMBRA_LS_ORTHO 0u       /* directional light: parallel rays, map on a plane */
@@ -82,6 +115,7 @@ typedef struct UmbraShadow {
     uint32_t map_size;        /* light-space maps: texels per side */
     uint32_t ls_mode;         /* light-space maps: UMBRA_LS_* */
     uint32_t pad;
+    UmbraClip clip;           /* the clip region, which view rays and light rays share */
 } UmbraShadow;
 
 #endif

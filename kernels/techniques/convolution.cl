@@ -279,6 +279,11 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
                 continue;
             }
             const float3 p = P.o + P.d * (z / P.cosv);
+            /* A sample the clip region leaves out is neither seen nor attenuates the light. */
+            if (!clip_keeps(&S->clip, p)) {
+                have_front = 0;
+                continue;
+            }
             if (skip) {
                 int b = brick_index(g, p);
                 if (!view_bricks[b] && !light_cells[b])
@@ -300,14 +305,20 @@ __kernel void convolution_slice(__global const UmbraFrame *F, VOLUME_PARAM,
                     next_cached = 1;
                 }
             } else {
+#if UMBRA_MIXED
+                c = alpha_for_fraction(view_sample(F, vol, g, view_tf, F->tf_size, p), r_view);
+                pass = light_pass(light_sample(F, vol, g, light_tf, F->light_tf_size, p),
+                                  r_light * h_light, flags);
+#else
                 float s = sample_volume(vol, g, p);
                 c = alpha_for_fraction(tf_lookup(view_tf, F->tf_size, s), r_view);
                 pass = light_pass(tf_lookup(light_tf, F->light_tf_size, s), r_light * h_light,
                                   flags);
+#endif
             }
             T *= pass;
             if (c.w > 0.0f && !(alpha > F->termination)) {
-                float3 grad = (flags & UMBRA_FLAG_SHADING) ? volume_gradient(vol, g, p)
+                float3 grad = (flags & UMBRA_FLAG_SHADING) ? view_gradient(F, vol, g, view_tf, p)
                                                            : (float3)(0.0f);
                 float3 amb, coef;
                 conv_shade(F, c.xyz, p, -P.d, grad, &amb, &coef);

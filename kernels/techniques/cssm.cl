@@ -161,7 +161,7 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             if (!(seg > 0.0f))
                 break;
             const float t_mid = tb.x + (float)k * h + 0.5f * seg;
-            const float4 col = tf_lookup(light_tf, n_tf, sample_volume(vol, g, o + t_mid * d));
+            const float4 col = light_sample(F, vol, g, light_tf, n_tf, o + t_mid * d);
             if (col.w > 0.0f) {
                 tau += cssm_depth(col, h_vox * (seg / h), flags);
                 if (light_any_gt(tau, e_next)) {

@@ -483,6 +483,9 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     int ne = 0;
     if (T->done)
         return 0;
+#if UMBRA_MIXED
+    use_lut = 0u; /* the segment table is over one transfer function (host/techniques/deep.c) */
+#endif
     const float h = S->step;
     const uint n_tf = F->light_tf_size, flags = F->flags;
     const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
@@ -567,7 +570,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
         } else {
             s->has_prev = 0;
             float3 mid = s->o + 0.5f * (a + b) * s->d;
-            const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, mid));
+            const float4 c = light_sample(F, vol, g, light_tf, n_tf, mid);
             float xa = (a - t0) / h, xb = (b - t0) / h;
             if (xa > 0.0f) {
                 p->x[p->n] = xa;

@@ -74,7 +74,7 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_start = tb.x + (float)k * h;
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
-            const float4 c = tf_lookup(light_tf, n_tf, sample_volume(vol, g, q));
+            const float4 c = light_sample(F, vol, g, light_tf, n_tf, q);
             if (c.w > 0.0f) {
                 if (product) {
                     const float p = P * (1.0f - fmin(c.w, UMBRA_ALPHA_MAX));

@@ -202,6 +202,11 @@ struct Renderer {
     std::optional<umbra_light> light;
     umbra_render_desc options;
     umbra_shadow_desc shadow;
+    umbra_clip_desc clip;
+    /* Channels 1.. of a multi-channel volume: their transfer functions (None: not set). */
+    nb::object channel_tf[UMBRA_MAX_CHANNELS] = {nb::none(), nb::none(), nb::none(), nb::none()};
+    nb::object channel_light_tf[UMBRA_MAX_CHANNELS] = {nb::none(), nb::none(), nb::none(),
+                                                       nb::none()};
     /* The Python progress callable (None: none), and whether a Python exception (the callable's,
      * or KeyboardInterrupt from a signal) cancelled the call in flight and waits in Python's
      * error indicator to be raised when the C call returns. */
@@ -235,6 +240,8 @@ struct Renderer {
         h = nullptr;
         ctx = nullptr;
         volume = tf = light_tf = progress = nb::none();
+        for (int c = 0; c < UMBRA_MAX_CHANNELS; ++c)
+            channel_tf[c] = channel_light_tf[c] = nb::none();
     }
     umbra_renderer get() const
     {

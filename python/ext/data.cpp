@@ -200,7 +200,7 @@ void refuse_image_object(nb::handle data)
  * with or without a given value range, so the binding does not scan the array again. */
 Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<range_t> value_range,
                    uint32_t brick_size, std::optional<vec3> origin,
-                   std::optional<std::array<vec3, 3>> directions)
+                   std::optional<std::array<vec3, 3>> directions, bool labels)
 {
     umbra_context c = ctx.get();
     refuse_image_object(data);
@@ -211,9 +211,16 @@ Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<ra
     a = as_array(held, "umbra.Volume: data");
     umbra_volume_desc d;
     umbra_volume_desc_init(&d);
-    if (a.ndim() != 3)
+    /* A 4-D (z, y, x, c) array is a volume of c channels, channel fastest as umbra takes it. */
+    if (a.ndim() == 4 && (a.shape(3) < 1 || a.shape(3) > UMBRA_MAX_CHANNELS))
+        raise_invalid("umbra.Volume: data has shape " + shape_text(a) + ": " +
+                      std::to_string(a.shape(3)) + " channels, need 1 to " +
+                      std::to_string(UMBRA_MAX_CHANNELS));
+    if (a.ndim() != 3 && a.ndim() != 4)
         raise_invalid("umbra.Volume: data has shape " + shape_text(a) +
-                      "; need a 3-D array of shape (z, y, x)");
+                      "; need a 3-D array of shape (z, y, x), or (z, y, x, channels)");
+    d.channels = a.ndim() == 4 ? (uint32_t)a.shape(3) : 1;
+    d.labels = labels ? 1 : 0;
     need_c_contiguous(a, "umbra.Volume: data",
                       "pass numpy.ascontiguousarray(data) (an array of shape (x, y, z) in "
                       "Fortran order, as nibabel returns, is C-contiguous as data.T)");
@@ -249,6 +256,47 @@ Volume make_volume(Context &ctx, nb::handle data, vec3 spacing, std::optional<ra
     check(c, vox.convert ? umbra_volume_create_filled(c, &d, fill_converted, &vox, &v)
                          : umbra_volume_create(c, &d, &v));
     return Volume(c, v);
+}
+
+/* Volume.update: the voxels of a sub-box (origin given) or of the whole volume, in place. The
+ * array must hold the volume's own type (no conversion: a value the conversion would change
+ * could not match a fresh volume's). */
+void update_volume(Volume &vol, nb::handle data, std::optional<std::array<uint32_t, 3>> origin)
+{
+    umbra_volume h = vol.get("Volume");
+    umbra_volume_info info;
+    check(vol.ctx, umbra_volume_get_info(h, &info));
+    any_array a = as_array(data, "umbra.Volume.update: data");
+    const size_t want = info.channels > 1 ? 4 : 3;
+    if (a.ndim() != want || (want == 4 && a.shape(3) != info.channels))
+        raise_invalid("umbra.Volume.update: data has shape " + shape_text(a) + "; need (z, y, x" +
+                      (want == 4 ? ", " + std::to_string(info.channels) : std::string()) +
+                      ") for this volume");
+    need_c_contiguous(a, "umbra.Volume.update: data", "pass numpy.ascontiguousarray(data)");
+    static const struct {
+        umbra_scalar_type type;
+        nb::dlpack::dtype dtype;
+        const char *name;
+    } types[] = {{UMBRA_UINT8, nb::dtype<uint8_t>(), "uint8"},
+                 {UMBRA_UINT16, nb::dtype<uint16_t>(), "uint16"},
+                 {UMBRA_INT16, nb::dtype<int16_t>(), "int16"},
+                 {UMBRA_FLOAT32, nb::dtype<float>(), "float32"}};
+    for (const auto &t : types)
+        if (t.type == info.type && a.dtype() != t.dtype)
+            raise_invalid("umbra.Volume.update: dtype " + dtype_name(a.dtype()) +
+                          " is not the volume's " + t.name + "; pass data.astype(numpy." +
+                          t.name + ")");
+    umbra_volume_update_desc d;
+    umbra_volume_update_desc_init(&d);
+    d.data = a.data();
+    for (int i = 0; i < 3; ++i) {
+        if (a.shape(2 - i) > UINT32_MAX)
+            raise_invalid("umbra.Volume.update: axis of size " + std::to_string(a.shape(2 - i)) +
+                          " is too large");
+        d.size[i] = (uint32_t)a.shape(2 - i);
+        d.origin[i] = origin ? (*origin)[i] : 0;
+    }
+    check(vol.ctx, umbra_volume_update(h, &d));
 }
 
 template <size_t N> nb::tuple floats(const float *p)
@@ -327,9 +375,9 @@ void bind_data(nb::module_ &m)
             "__init__",
             [](Volume *self, Context &ctx, nb::handle data, vec3 spacing,
                std::optional<range_t> value_range, uint32_t brick_size, std::optional<vec3> origin,
-               std::optional<std::array<vec3, 3>> directions) {
-                Volume v =
-                    make_volume(ctx, data, spacing, value_range, brick_size, origin, directions);
+               std::optional<std::array<vec3, 3>> directions, bool labels) {
+                Volume v = make_volume(ctx, data, spacing, value_range, brick_size, origin,
+                                       directions, labels);
                 new (self) Volume(std::move(v));
             },
             "context"_a, "data"_a, nb::kw_only(),
@@ -337,6 +385,11 @@ void bind_data(nb::module_ &m)
                                volume_defaults.spacing[2]},
             "value_range"_a = nb::none(), "brick_size"_a = volume_defaults.brick_size,
             "origin"_a = nb::none(), "directions"_a = nb::none(),
+            "labels"_a = volume_defaults.labels != 0,
+            "data: (z, y, x), or (z, y, x, c) for a volume of c channels (1 to 4: one transfer "
+            "function each, Renderer.set_channel_tf). labels: the voxels (uint8 or uint16, one "
+            "channel) are labels, sampled at the nearest voxel; the transfer function's entry "
+            "i is label i's colour and opacity (umbra_volume_desc.labels).\n"
             "spacing: world units per voxel as (sx, sy, sz), x first like umbra's dims, i.e. the "
             "reverse of the array's (z, y, x) axis order (SimpleITK's GetSpacing() order). "
             "value_range: (min, max) mapped to [0, 1] before the transfer function; None: the "
@@ -370,6 +423,15 @@ void bind_data(nb::module_ &m)
                     "cell-data array (None: the active point scalars, else the only point "
                     "array, else the same for cell data; cell data are voxels centred in the "
                     "cells). kwargs: value_range, brick_size.")
+        .def("update", &update_volume, "data"_a, nb::kw_only(), "origin"_a = nb::none(),
+             "umbra_volume_update: writes data, of the volume's own dtype and shape (z, y, x) "
+             "(or (z, y, x, channels)), into the volume in place: at voxel origin (x, y, z) as a "
+             "sub-box, or, without origin, as all of it (the next time step of a series). The "
+             "value range stays the one set at creation (values outside it clamp). Renderers "
+             "rebuild only what the change touches (their shadow structures, and visibility "
+             "tables where a brick's range changed); a render then equals, bit for bit, one of "
+             "a fresh volume of the new voxels with the same value range. info.version counts "
+             "the updates.")
         .def("close", &Volume::close, "Drops this object's reference; idempotent.")
         .def_prop_ro("closed", [](const Volume &v) { return v.h == nullptr; })
         .def(
@@ -418,6 +480,24 @@ void bind_data(nb::module_ &m)
             },
             nb::sig("def value_range(self, /) -> tuple[float, float]"),
             "the values mapped to 0 and 1 before the transfer function")
+        .def_prop_ro("channels", [](const VolumeInfo &i) { return i.info.channels; },
+                     "values per voxel (1 to 4)")
+        .def_prop_ro(
+            "labels", [](const VolumeInfo &i) { return i.info.labels != 0; },
+            "True for a label map")
+        .def_prop_ro(
+            "channel_ranges",
+            [](const VolumeInfo &i) {
+                nb::list l;
+                for (uint32_t c = 0; c < i.info.channels; ++c)
+                    l.append(nb::make_tuple(py_float(i.info.channel_min[c]),
+                                            py_float(i.info.channel_max[c])));
+                return nb::tuple(l);
+            },
+            nb::sig("def channel_ranges(self, /) -> tuple[tuple[float, float], ...]"),
+            "each channel's value range (min, max)")
+        .def_prop_ro("version", [](const VolumeInfo &i) { return i.info.version; },
+                     "0 when made, one more for each Volume.update")
         .def_prop_ro("brick_size", [](const VolumeInfo &i) { return i.info.brick_size; })
         .def_prop_ro(
             "brick_counts",

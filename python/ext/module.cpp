@@ -57,6 +57,13 @@ NB_MODULE(_umbra, m)
         .value("AUTO", UMBRA_INTERACTION_AUTO,
                "a frame after a light or transfer-function change uses the technique's draft, "
                "the next frame with nothing changed the full structure");
+    nb::enum_<umbra_render_mode>(m, "RenderMode", "umbra_render_mode: how a view ray combines "
+                                                  "its samples")
+        .value("COMPOSITE", UMBRA_RENDER_COMPOSITE,
+               "emission-absorption compositing, lit and shadowed")
+        .value("MIP", UMBRA_RENDER_MIP, "maximum intensity projection")
+        .value("MINIP", UMBRA_RENDER_MINIP, "minimum intensity projection")
+        .value("AVERAGE", UMBRA_RENDER_AVERAGE, "average intensity projection");
 
     nb::enum_<umbra_projection>(m, "Projection", "umbra_projection")
         .value("PERSPECTIVE", UMBRA_PERSPECTIVE)

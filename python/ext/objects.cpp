@@ -75,6 +75,65 @@ void renderer_set_light_tf(Renderer &r, nb::handle t)
     r.light_tf = nb::borrow(t);
 }
 
+/* set_clip(planes=..., crop=...): every plane (a, b, c, d) keeps a x + b y + c z + d >= 0 in
+ * the world; crop is ((x0, y0, z0), (x1, y1, z1)) in voxels, or None. The C call checks the
+ * values and names the bad one. */
+void renderer_set_clip(Renderer &r, const std::vector<std::array<float, 4>> &planes,
+                       std::optional<std::array<std::array<float, 3>, 2>> crop)
+{
+    umbra_clip_desc d;
+    umbra_clip_desc_init(&d);
+    if (planes.size() > UMBRA_MAX_CLIP_PLANES)
+        raise_invalid("umbra.Renderer.set_clip: " + std::to_string(planes.size()) +
+                      " planes, at most " + std::to_string(UMBRA_MAX_CLIP_PLANES));
+    d.plane_count = (uint32_t)planes.size();
+    for (size_t i = 0; i < planes.size(); ++i)
+        for (int k = 0; k < 4; ++k)
+            d.planes[i][k] = planes[i][k];
+    if (crop) {
+        d.crop = 1;
+        for (int k = 0; k < 3; ++k) {
+            d.crop_min[k] = (*crop)[0][k];
+            d.crop_max[k] = (*crop)[1][k];
+        }
+    }
+    check(r.ctx, umbra_renderer_set_clip(r.get(), &d));
+    r.clip = d;
+}
+
+nb::object clip_planes(const Renderer &r)
+{
+    nb::list l;
+    for (uint32_t i = 0; i < r.clip.plane_count; ++i)
+        l.append(nb::make_tuple(py_float(r.clip.planes[i][0]), py_float(r.clip.planes[i][1]),
+                                py_float(r.clip.planes[i][2]), py_float(r.clip.planes[i][3])));
+    return nb::list(l);
+}
+
+nb::object clip_crop(const Renderer &r)
+{
+    if (!r.clip.crop)
+        return nb::none();
+    const float *a = r.clip.crop_min, *b = r.clip.crop_max;
+    return nb::make_tuple(nb::make_tuple(py_float(a[0]), py_float(a[1]), py_float(a[2])),
+                          nb::make_tuple(py_float(b[0]), py_float(b[1]), py_float(b[2])));
+}
+
+void renderer_set_channel_tf(Renderer &r, uint32_t channel, nb::handle t, nb::handle lt)
+{
+    umbra_transfer_function h = nb::cast<TransferFunction &>(t).get("TransferFunction");
+    umbra_transfer_function lh =
+        lt.is_none() ? nullptr : nb::cast<TransferFunction &>(lt).get("TransferFunction");
+    check(r.ctx, umbra_renderer_set_channel_transfer_function(r.get(), channel, h, lh));
+    if (channel == 0) { /* channel 0's are the renderer's own */
+        r.tf = nb::borrow(t);
+        r.light_tf = nb::borrow(lt);
+    } else {
+        r.channel_tf[channel] = nb::borrow(t);
+        r.channel_light_tf[channel] = nb::borrow(lt);
+    }
+}
+
 void renderer_set_camera(Renderer &r, const umbra_camera &c)
 {
     check(r.ctx, umbra_renderer_set_camera(r.get(), &c));
@@ -132,6 +191,10 @@ int renderer_traverse(PyObject *self, visitproc visit, void *arg)
     Py_VISIT(r->volume.ptr());
     Py_VISIT(r->tf.ptr());
     Py_VISIT(r->light_tf.ptr());
+    for (int c = 0; c < UMBRA_MAX_CHANNELS; ++c) {
+        Py_VISIT(r->channel_tf[c].ptr());
+        Py_VISIT(r->channel_light_tf[c].ptr());
+    }
     return 0;
 }
 
@@ -389,6 +452,7 @@ void bind_objects(nb::module_ &m)
                 try {
                     umbra_render_desc_init(&self->options);
                     umbra_shadow_desc_init(&self->shadow);
+                    umbra_clip_desc_init(&self->clip);
                     check(c, umbra_renderer_create(c, &self->h));
                     self->ctx = c;
                     umbra_context_retain(c);
@@ -461,6 +525,30 @@ void bind_objects(nb::module_ &m)
             "shadow", [](const Renderer &r) { return r.shadow; },
             [](Renderer &r, const umbra_shadow_desc &d) { renderer_set_shadow(r, d); },
             "A copy of the shadow options; assign a ShadowOptions to change them.")
+        .def("set_clip", &renderer_set_clip, nb::kw_only(),
+             "planes"_a = std::vector<std::array<float, 4>>{}, "crop"_a = nb::none(),
+             "umbra_renderer_set_clip: keeps only the region every plane and the crop box keep, "
+             "for the view and the light alike (a clipped-away occluder casts no shadow, in "
+             "every technique). planes: up to 6 (a, b, c, d) in the volume's world, each "
+             "keeping a x + b y + c z + d >= 0. crop: ((x0, y0, z0), (x1, y1, z1)) in voxel "
+             "coordinates (voxel (i, j, k)'s centre at (i, j, k)), or None. Replaces the "
+             "previous region; set_clip() clips nothing. A bad value raises umbra.Error naming "
+             "it and changes nothing.")
+        .def_prop_ro("clip_planes", &clip_planes,
+                     nb::sig("def clip_planes(self, /) -> list[tuple[float, float, float, "
+                             "float]]"),
+                     "The clip planes set with set_clip.")
+        .def_prop_ro("crop", &clip_crop,
+                     nb::sig("def crop(self, /) -> tuple[tuple[float, float, float], "
+                             "tuple[float, float, float]] | None"),
+                     "The crop box set with set_clip, or None.")
+        .def("set_channel_tf", &renderer_set_channel_tf, "channel"_a, "tf"_a,
+             "light_tf"_a.none() = nb::none(),
+             "umbra_renderer_set_channel_transfer_function: the transfer functions of channel "
+             "`channel` of a multi-channel volume (channel 0's are tf and light_tf). The "
+             "channels mix as emission-absorption media: colours weighted by extinction, the "
+             "light absorbed by the summed extinction, so shadows take the colour of what casts "
+             "them. Every channel needs one before render().")
         .def(
             "set_shadow",
             [](Renderer &r, const nb::kwargs &kw) {

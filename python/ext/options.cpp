@@ -266,6 +266,9 @@ void bind_options(nb::module_ &m)
                "progressive shadows: 'auto' renders the technique's draft in a frame after a light "
                "or transfer-function change and the full structure once nothing changes "
                "(RenderStats.draft says which); 'off' (default) always the full one");
+    enum_field(ro, "mode", &umbra_render_desc::mode, "RenderMode",
+               "composite (lit, shadowed), or a projection: mip, minip, average (technique "
+               "none only; docs/features.md)");
     make_repr(ro, "RenderOptions");
 
     nb::class_<umbra_shadow_desc> so(m, "ShadowOptions");

@@ -30,7 +30,7 @@ def test_volume_not_contiguous(ctx):
         umbra.Volume(ctx, np.asfortranarray(data))
 
 
-@pytest.mark.parametrize("shape", [(8, 8), (2, 2, 2, 2), (64,)])
+@pytest.mark.parametrize("shape", [(8, 8), (2, 2, 2, 2, 2), (64,)])
 def test_volume_wrong_shape(ctx, shape):
     with raises_invalid(r"shape \(.*need a 3-D array of shape \(z, y, x\)"):
         umbra.Volume(ctx, np.zeros(shape, np.float32))

@@ -103,6 +103,36 @@ expect 1 "outside every data root given" -- --volume "$tmp/hdr/up.nhdr" \
     --allow-data-root "$tmp/hdr" --size 16x16 --out "$tmp/a.png"
 expect 1 "--allow-data-root needs a value" -- --allow-data-root
 
+# #31: render modes, clipping, multi-channel raw files and label maps.
+expect 0 "wrote" -- "${small[@]}" --mode mip --clip-plane 0,1,0,0 --crop 0,0,0,12,15,15 \
+    --out "$tmp/a.png"
+expect 1 "--mode 'max' is not composite, mip, minip or average" -- --mode max
+expect 1 "render mode 'average' is a projection without light" -- "${small[@]}" --mode average \
+    --technique threshold --out "$tmp/a.png"
+expect 1 "--clip-plane '1,0,0' is not A,B,C,D" -- --clip-plane 1,0,0
+planes=()
+for i in 1 2 3 4 5 6 7; do planes+=(--clip-plane "1,0,0,$i"); done
+expect 1 "at most 6 --clip-plane" -- "${planes[@]}"
+expect 1 "plane 0 (0, 0, 0, 1) must be finite with a non-zero normal" -- "${small[@]}" \
+    --clip-plane 0,0,0,1 --out "$tmp/a.png"
+expect 1 "--crop '1,2,3' is not X0,Y0,Z0,X1,Y1,Z1" -- --crop 1,2,3
+expect 1 "crop box along x [5, 2] voxels" -- "${small[@]}" --crop 5,0,0,2,8,8 --out "$tmp/a.png"
+head -c 2048 /dev/zero >"$tmp/two.raw"
+expect 0 "wrote" -- --raw "$tmp/two.raw" --raw-dims 8x8x8 --raw-type uint16 --raw-channels 2 \
+    --size 16x16 --out "$tmp/a.png"
+expect 1 "holds 2048 bytes, expected 3072" -- --raw "$tmp/two.raw" --raw-dims 8x8x8 \
+    --raw-type uint16 --raw-channels 3 --size 16x16 --out "$tmp/a.png"
+expect 1 "--raw-channels '5' is not a whole number in [1, 4]" -- --raw-channels 5
+expect 1 "--raw-channels and --labels describe a --raw file" -- "${small[@]}" --labels \
+    --out "$tmp/a.png"
+expect 0 "wrote" -- --raw "$tmp/two.raw" --raw-dims 16x16x8 --raw-type uint8 --labels \
+    --technique deep --size 16x16 --out "$tmp/a.png"
+expect 1 "a label map has one channel of uint8 or uint16 labels" -- --raw "$tmp/two.raw" \
+    --raw-dims 8x8x8 --raw-type float32 --labels --size 16x16 --out "$tmp/a.png"
+printf '0 1 1 1 0\n1 1 1 1 0.5\n' >"$tmp/c.tf"
+expect 1 "2 --channel-tf for a volume of 1 channel" -- "${small[@]}" --channel-tf "$tmp/c.tf" \
+    --channel-tf "$tmp/c.tf" --out "$tmp/a.png"
+
 if [[ $failures -ne 0 ]]; then
     echo "$failures case(s) failed"
     exit 1

@@ -9,6 +9,9 @@
 #                ../shared/data, which CI does not have), loaded from a NRRD file with
 #                examples/walnut.tf, the walnut example's camera and point light, deep shadow map,
 #                shading, --no-gui
+#   clip         the spheres clipped (a plane and a crop box, threshold shadows) and in MIP: the
+#                view the viewer prints carries --clip-plane, --crop and --mode, and umbra-render
+#                given it draws the viewer's frame (outside the panel)
 #   options      the command line, without a window: the viewer's own options refused with
 #                exit 1 and a message naming the value, umbra-render's options and files
 #                checked by umbra-render's parser (one getopt_long table: prefixes, --opt=value,
@@ -93,6 +96,26 @@ light_orbit)
     "$render" --scene spheres $viewargs --out render.png
     "$python" "$src/tests/viewer/compare.py" view.png render.png --skip "$panel" ||
         fail "the images differ outside the panel"
+    ;;
+clip)
+    # The clip region and the projection mode as the panel keeps them: the view the viewer prints
+    # carries them (--clip-plane, --crop, --mode), and umbra-render given that view draws the
+    # viewer's frame. Threshold-map shadows with a plane and a crop box; then MIP with a crop box.
+    for extra in "--technique threshold --clip-plane 1,0,0.25,0.125 --crop 2,0,4,60,50,58" \
+                 "--technique none --mode mip --crop 0,8,0,63,63,50"; do
+        # shellcheck disable=SC2086 # a list of options
+        run_view --scene spheres $extra --size 320x200 --frames 1 --snapshot view.png
+        viewargs=$(sed -n 's/^view: //p' view.out)
+        for want in $(grep -o -- '--[a-z-]* [^ ]*' <<<"$extra" | tr ' ' '='); do
+            grep -qe " ${want/=/ }" <<<" $viewargs" || fail "the view lacks ${want/=/ }: $viewargs"
+        done
+        panel=$(sed -n 's/.*panel at \([0-9]*\),\([0-9]*\) size \([0-9]*\)x\([0-9]*\).*/\1,\2,\3,\4/p' \
+                view.err)
+        # shellcheck disable=SC2086 # the view is a list of options
+        "$render" --scene spheres $viewargs --out render.png
+        "$python" "$src/tests/viewer/compare.py" view.png render.png --skip "$panel" ||
+            fail "the images differ outside the panel ($extra)"
+    done
     ;;
 options)
     # expect STATUS NEEDLE ARGS...: umbra-view ARGS exits with STATUS and stdout+stderr hold NEEDLE.

@@ -264,6 +264,16 @@ static void print_view(const viewer *v, FILE *f)
             o->transmission == UMBRA_TRANSMISSION_COLORED ? "--colored" : "--grey",
             o->preintegrated ? " --preintegrated" : "",
             o->interaction == UMBRA_INTERACTION_AUTO ? "auto" : "off");
+    static const char *const modes[] = {"composite", "mip", "minip", "average"};
+    if (o->mode != UMBRA_RENDER_COMPOSITE && (unsigned)o->mode < 4)
+        fprintf(f, " --mode %s", modes[o->mode]);
+    const umbra_clip_desc *cl = &v->s.clip;
+    for (uint32_t i = 0; i < cl->plane_count; ++i)
+        fprintf(f, " --clip-plane %.9g,%.9g,%.9g,%.9g", cl->planes[i][0], cl->planes[i][1],
+                cl->planes[i][2], cl->planes[i][3]);
+    if (cl->crop)
+        fprintf(f, " --crop %.9g,%.9g,%.9g,%.9g,%.9g,%.9g", cl->crop_min[0], cl->crop_min[1],
+                cl->crop_min[2], cl->crop_max[0], cl->crop_max[1], cl->crop_max[2]);
     /* Every parameter of the technique, by its registry key. */
     const umbra_technique_info *t = umbra_technique_find_id(v->s.shadow.technique);
     for (uint32_t k = 0; t && k < t->param_count; ++k) {
@@ -328,6 +338,7 @@ static umbra_status render_frame(viewer *v)
     SET(VIEW_CHANGED_LIGHT, umbra_renderer_set_light(r, &v->s.light), "light")
     SET(VIEW_CHANGED_OPTIONS, umbra_renderer_set_options(r, &v->s.options), "options")
     SET(VIEW_CHANGED_SHADOW, umbra_renderer_set_shadow(r, &v->s.shadow), "shadow")
+    SET(VIEW_CHANGED_CLIP, umbra_renderer_set_clip(r, &v->s.clip), "clip")
 #undef SET
     if (ch & VIEW_CHANGED_SIZE) {
         float *px = malloc((size_t)v->width * v->height * 4 * sizeof *px);

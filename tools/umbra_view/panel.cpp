@@ -287,6 +287,72 @@ void section_render(viewer *v)
     if (ImGui::SliderFloat("step", &o->step, 0.05f, 4.0f, "%.3g voxels",
                            ImGuiSliderFlags_Logarithmic))
         v->changed |= VIEW_CHANGED_OPTIONS;
+    // The projection modes draw no light: they take technique none (the library says so).
+    static const char *const modes[] = {"composite", "mip", "minip", "average"};
+    int mode = (int)o->mode;
+    if (ImGui::Combo("mode", &mode, modes, 4)) {
+        o->mode = (umbra_render_mode)mode;
+        v->changed |= VIEW_CHANGED_OPTIONS;
+    }
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("maximum, minimum and average intensity projection draw no light: "
+                          "choose technique none with them");
+}
+
+// Clipping: one plane (its normal and its distance from the volume's centre) and the crop box,
+// as fractions of the volume along each axis. Both apply to the light as to the view.
+void section_clip(viewer *v)
+{
+    umbra_clip_desc *c = &v->s.clip;
+    umbra_volume_info info;
+    if (umbra_volume_get_info(v->s.view_volume, &info) != UMBRA_SUCCESS)
+        return;
+    bool plane = c->plane_count > 0;
+    if (ImGui::Checkbox("clip plane", &plane)) {
+        c->plane_count = plane ? 1 : 0;
+        if (plane && c->planes[0][0] == 0.0f && c->planes[0][1] == 0.0f &&
+            c->planes[0][2] == 0.0f) {
+            c->planes[0][0] = -1.0f; // keeps x <= centre: the near half from the default view
+            c->planes[0][3] = info.center[0];
+        }
+        v->changed |= VIEW_CHANGED_CLIP;
+    }
+    if (plane) {
+        float *p = c->planes[0];
+        if (ImGui::SliderFloat3("normal", p, -1.0f, 1.0f, "%.2f")) {
+            if (p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f)
+                p[1] = 1e-3f; // the library refuses a zero normal
+            v->changed |= VIEW_CHANGED_CLIP;
+        }
+        // d such that the plane passes at `offset` from the centre along the normal.
+        const float n = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        const float dc = p[0] * info.center[0] + p[1] * info.center[1] + p[2] * info.center[2];
+        float offset = (p[3] + dc) / n;
+        if (ImGui::SliderFloat("offset", &offset, -0.5f * v->diagonal, 0.5f * v->diagonal,
+                               "%.3g")) {
+            p[3] = offset * n - dc;
+            v->changed |= VIEW_CHANGED_CLIP;
+        }
+    }
+    bool crop = c->crop != 0;
+    if (ImGui::Checkbox("crop box", &crop)) {
+        c->crop = crop;
+        if (crop && c->crop_min[0] == 0.0f && c->crop_max[0] == 0.0f)
+            for (int a = 0; a < 3; ++a) {
+                c->crop_min[a] = -0.5f;
+                c->crop_max[a] = (float)info.dims[a] - 0.5f;
+            }
+        v->changed |= VIEW_CHANGED_CLIP;
+    }
+    if (crop) {
+        static const char *const names[3] = {"x", "y", "z"};
+        for (int a = 0; a < 3; ++a) {
+            const float hi = (float)info.dims[a] - 0.5f;
+            if (ImGui::DragFloatRange2(names[a], &c->crop_min[a], &c->crop_max[a], 0.25f, -0.5f,
+                                       hi, "%.1f", "%.1f", ImGuiSliderFlags_AlwaysClamp))
+                v->changed |= VIEW_CHANGED_CLIP;
+        }
+    }
 }
 
 // The opacity curve: the table's alpha over its entries, filled with each entry's colour. A drag
@@ -391,6 +457,8 @@ void draw_panel(viewer *v)
             section_light(v);
         if (ImGui::CollapsingHeader("rendering", ImGuiTreeNodeFlags_DefaultOpen))
             section_render(v);
+        if (ImGui::CollapsingHeader("clipping"))
+            section_clip(v);
         if (ImGui::CollapsingHeader("transfer function", ImGuiTreeNodeFlags_DefaultOpen))
             section_tf(v);
         if (ImGui::CollapsingHeader("keys and mouse"))

@@ -22,7 +22,8 @@ enum {
     VIEW_CHANGED_OPTIONS = 4,
     VIEW_CHANGED_SHADOW = 8,
     VIEW_CHANGED_TF = 16,
-    VIEW_CHANGED_SIZE = 32
+    VIEW_CHANGED_SIZE = 32,
+    VIEW_CHANGED_CLIP = 64
 };
 
 typedef struct view_frame_times {
