@@ -12,9 +12,12 @@
  *   opacity the transfer function's opacity is scaled by a factor that changes every frame (a
  *           new transfer function each frame, set on the renderer): the light pass uses it, so
  *           every frame rebuilds the map, and the view tables are rebuilt as well;
- *   light-draft the light orbits as in light, with the map at one texel per voxel
- *           (map_texels_per_voxel 1: what an application asks for while the user drags the light;
- *           CSSM and deep only, at the auto size: the threshold map is built so anyway).
+ *   light-auto the light orbits as in light on a renderer with progressive shadows
+ *           (umbra_render_desc.interaction UMBRA_INTERACTION_AUTO): every frame builds the
+ *           technique's draft (umbra_technique_info.draft; the threshold map has none and builds
+ *           its full map). After the timed frames one more frame with nothing changed builds the
+ *           full map: its time is reported (stop ms) and its image is compared, bit for bit, with
+ *           a fresh renderer's full render of the same view (stop identical).
  * A frame's time is the host wall clock of umbra_renderer_render (build, render and read-back of
  * the image: what an application waits for). The unshadowed frame of the same view is rendered by
  * a second renderer (technique none) on the same volume in turn with the shadowed one, frame by
@@ -50,8 +53,8 @@ typedef struct options {
     const char *results, *device;
 } options;
 
-typedef enum sequence { SEQ_CAMERA, SEQ_LIGHT, SEQ_OPACITY, SEQ_LIGHT_DRAFT, SEQ_COUNT } sequence;
-static const char *const sequence_names[SEQ_COUNT] = {"camera", "light", "opacity", "light-draft"};
+typedef enum sequence { SEQ_CAMERA, SEQ_LIGHT, SEQ_OPACITY, SEQ_LIGHT_AUTO, SEQ_COUNT } sequence;
+static const char *const sequence_names[SEQ_COUNT] = {"camera", "light", "opacity", "light-auto"};
 
 typedef struct row {
     char scene[SCENE_NAME_MAX];
@@ -61,6 +64,10 @@ typedef struct row {
     uint32_t map_lo, map_hi, width, height; /* map sizes seen over the timed frames */
     bench_timing shadowed, none;
     bench_timing build; /* the shadow build's share of the shadowed frames (stats.shadow_build_ms) */
+    int drafts;         /* timed frames that used the technique's draft (stats.draft) */
+    double stop_ms;     /* light-auto: the frame after the light stopped (the full map), else 0 */
+    int stop_identical; /* light-auto: that frame equals a fresh renderer's bit for bit (1), or
+                           not (0); -1 for the other sequences */
 } row;
 
 /* Everything one scene's sequences share: the volume, the scene's transfer function (its table
@@ -81,15 +88,16 @@ static void usage(FILE *f)
             "usage: umbra-bench interactive [options]\n"
             "  per scene, shading on and off, and technique: frames in which the camera orbits\n"
             "  (map cached), the light orbits (map rebuilt), the opacity changes (map and\n"
-            "  tables rebuilt) and the light orbits with draft maps (1 texel per voxel); median\n"
-            "  and max ms per frame, each over the unshadowed frame\n"
+            "  tables rebuilt) and the light orbits with progressive shadows (interaction auto:\n"
+            "  draft maps, then the full map once the light stops); median and max ms per\n"
+            "  frame, each over the unshadowed frame\n"
             "  --quick          3 frames, 1 warm-up, images capped at 192 pixels\n"
             "  --frames N       timed frames per sequence (default 24)\n"
             "  --warmup N       untimed frames before them (default 2)\n"
             "  --size WxH       image size (default: the scene's)\n"
             "  --scenes A,B     scene files' stems (default walnut,bonsai)\n"
             "  --techniques A,B (default: every light-space map)\n"
-            "  --sequences A,B  (default camera,light,opacity,light-draft)\n"
+            "  --sequences A,B  (default camera,light,opacity,light-auto)\n"
             "  --map-size auto|N  map size of the light-space techniques (default auto)\n"
             "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
             "  --results DIR    also write DIR/interactive.csv and DIR/interactive.md\n"
@@ -110,7 +118,7 @@ static int parse_options(int argc, char **argv, options *o)
             snprintf(o->techniques + n, sizeof o->techniques - n, "%s%s", n ? "," : "",
                      umbra_technique_get(t)->name);
         }
-    snprintf(o->sequences, sizeof o->sequences, "camera,light,opacity,light-draft");
+    snprintf(o->sequences, sizeof o->sequences, "camera,light,opacity,light-auto");
     snprintf(o->scene_dir, sizeof o->scene_dir, "%s/bench/scenes", UMBRA_SOURCE_DIR);
     int frames_given = 0, warmup_given = 0;
     for (int i = 1; i < argc; ++i) {
@@ -197,7 +205,7 @@ static umbra_status frame(session *S, sequence seq, int i, double *ms_shadowed, 
     umbra_transfer_function tf = NULL;
     if (seq == SEQ_CAMERA) {
         rotate_y(cam.eye, cam.target, STEP_DEGREES * (float)i);
-    } else if (seq == SEQ_LIGHT || seq == SEQ_LIGHT_DRAFT) {
+    } else if (seq == SEQ_LIGHT || seq == SEQ_LIGHT_AUTO) {
         float zero[3] = {0.0f, 0.0f, 0.0f};
         if (light.type == UMBRA_LIGHT_DIRECTIONAL)
             rotate_y(light.direction, zero, STEP_DEGREES * (float)(i + 1));
@@ -226,21 +234,20 @@ static umbra_status frame(session *S, sequence seq, int i, double *ms_shadowed, 
     return st;
 }
 
-/* The shadow of a sequence: the technique at map_size, with k texels per voxel (0: its own). */
-static umbra_shadow_desc shadow_for(umbra_shadow_technique t, uint32_t map_size, float k)
+/* The shadow of a sequence: the technique at map_size, its other parameters the defaults. */
+static umbra_shadow_desc shadow_for(umbra_shadow_technique t, uint32_t map_size)
 {
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
     sd.technique = t;
     sd.map.size = map_size;
-    sd.map.texels_per_voxel = k;
     return sd;
 }
 
 static umbra_status renderer_for(session *S, umbra_shadow_technique t, uint32_t map_size,
                                  umbra_renderer *out)
 {
-    const umbra_shadow_desc sd = shadow_for(t, map_size, 0.0f);
+    const umbra_shadow_desc sd = shadow_for(t, map_size);
     umbra_status st = umbra_renderer_create(S->ctx, out);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_volume(*out, S->scene.volume);
@@ -252,6 +259,45 @@ static umbra_status renderer_for(session *S, umbra_shadow_technique t, uint32_t 
         st = umbra_renderer_set_options(*out, &S->scene.options);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_set_shadow(*out, &sd);
+    return st;
+}
+
+/* light-auto: the frame after the light stopped at frame `last`'s position (nothing changed, so
+ * the full map), timed, and a fresh renderer's full render of the same view; r gets the time
+ * and whether the two images are the same bit for bit. */
+static umbra_status stop_frame(session *S, const options *o, umbra_shadow_technique t,
+                               int last, row *r)
+{
+    const size_t bytes = (size_t)S->width * S->height * 4 * sizeof(float);
+    float *fresh_img = malloc(bytes);
+    umbra_renderer fresh = NULL;
+    umbra_status st = fresh_img ? UMBRA_SUCCESS : UMBRA_ERROR_OUT_OF_MEMORY;
+    umbra_light light = S->scene.light;
+    const float zero[3] = {0.0f, 0.0f, 0.0f};
+    if (light.type == UMBRA_LIGHT_DIRECTIONAL)
+        rotate_y(light.direction, zero, STEP_DEGREES * (float)(last + 1));
+    else
+        rotate_y(light.position, S->center, STEP_DEGREES * (float)(last + 1));
+    double t0 = bench_now_ms();
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_render(S->shadowed, S->width, S->height, S->image);
+    r->stop_ms = bench_now_ms() - t0;
+    umbra_render_stats stats;
+    if (st == UMBRA_SUCCESS && (st = umbra_renderer_get_stats(S->shadowed, &stats)) ==
+                                   UMBRA_SUCCESS && stats.draft)
+        st = UMBRA_ERROR_INVALID_ARGUMENT; /* the frame after the light stopped must be full */
+    if (st == UMBRA_SUCCESS)
+        st = renderer_for(S, t, o->map_size, &fresh);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_set_camera(fresh, &S->scene.camera);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_set_light(fresh, &light);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_render(fresh, S->width, S->height, fresh_img);
+    if (st == UMBRA_SUCCESS)
+        r->stop_identical = memcmp(S->image, fresh_img, bytes) == 0;
+    umbra_renderer_release(fresh);
+    free(fresh_img);
     return st;
 }
 
@@ -272,8 +318,10 @@ static umbra_status run_sequence(session *S, const options *o, sequence seq, row
         if (st == UMBRA_SUCCESS && i >= o->warmup) {
             r->map_lo = stats.map_size < r->map_lo ? stats.map_size : r->map_lo;
             r->map_hi = stats.map_size > r->map_hi ? stats.map_size : r->map_hi;
+            r->drafts += stats.draft != 0;
         }
     }
+    r->stop_identical = -1;
     if (st == UMBRA_SUCCESS) {
         r->shadowed = bench_timing_of(a + o->warmup, o->frames);
         r->none = bench_timing_of(b + o->warmup, o->frames);
@@ -345,14 +393,12 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
             for (int q = 0; q < SEQ_COUNT && st == UMBRA_SUCCESS && *nrows < MAX_ROWS; ++q) {
                 if (!in_list(o->sequences, sequence_names[q]))
                     continue;
-                if (q == SEQ_LIGHT_DRAFT) {
-                    /* The last sequence: the renderer switches to the draft for it. */
-                    /* A map already at a texel per voxel (threshold) has no draft. */
-                    if (umbra_technique_find_id(techs[t])->map_texels_per_voxel <= 1.0f ||
-                        o->map_size != UMBRA_MAP_SIZE_AUTO)
-                        continue;
-                    const umbra_shadow_desc draft = shadow_for(techs[t], o->map_size, 1.0f);
-                    if ((st = umbra_renderer_set_shadow(S.shadowed, &draft)) != UMBRA_SUCCESS)
+                if (q == SEQ_LIGHT_AUTO) {
+                    /* The last sequence: progressive shadows on for it. */
+                    umbra_render_desc auto_opts = S.scene.options;
+                    auto_opts.interaction = UMBRA_INTERACTION_AUTO;
+                    if ((st = umbra_renderer_set_options(S.shadowed, &auto_opts)) !=
+                        UMBRA_SUCCESS)
                         break;
                 }
                 row *r = &rows[*nrows];
@@ -366,7 +412,10 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
                 fprintf(stderr, "interactive: %s, shading %s, %s, %s ...\n", name,
                         shading ? "on" : "off", umbra_shadow_technique_name(techs[t]),
                         sequence_names[q]);
-                if ((st = run_sequence(&S, o, (sequence)q, r)) == UMBRA_SUCCESS)
+                st = run_sequence(&S, o, (sequence)q, r);
+                if (st == UMBRA_SUCCESS && q == SEQ_LIGHT_AUTO)
+                    st = stop_frame(&S, o, techs[t], o->warmup + o->frames - 1, r);
+                if (st == UMBRA_SUCCESS)
                     ++*nrows;
             }
             umbra_renderer_release(S.shadowed);
@@ -387,19 +436,24 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
 
 #define CSV_HEADER                                                                                 \
     "scene,shading,technique,sequence,map_min,map_max,width,height,frames,ms_median,ms_max,"             \
-    "none_ms_median,none_ms_max,over_none_median,over_none_max,build_ms_median,build_ms_max"
+    "none_ms_median,none_ms_max,over_none_median,over_none_max,build_ms_median,build_ms_max,"        \
+    "drafts,stop_ms,stop_identical"
 
 static void csv_rows(FILE *f, const row *rows, int n)
 {
     fprintf(f, "%s\n", CSV_HEADER);
     for (int i = 0; i < n; ++i) {
         const row *r = &rows[i];
-        fprintf(f, "%s,%s,%s,%s,%u,%u,%u,%u,%d,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.2f,%.2f\n", r->scene,
+        fprintf(f, "%s,%s,%s,%s,%u,%u,%u,%u,%d,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.2f,%.2f,%d,", r->scene,
                 r->shading ? "on" : "off", umbra_shadow_technique_name(r->technique),
                 sequence_names[r->seq], r->map_lo, r->map_hi, r->width, r->height, r->shadowed.runs,
                 r->shadowed.median, r->shadowed.max, r->none.median, r->none.max,
                 r->shadowed.median / r->none.median, r->shadowed.max / r->none.max,
-                r->build.median, r->build.max);
+                r->build.median, r->build.max, r->drafts);
+        if (r->stop_identical >= 0)
+            fprintf(f, "%.2f,%s\n", r->stop_ms, r->stop_identical ? "yes" : "no");
+        else
+            fprintf(f, ",\n");
     }
 }
 
@@ -423,14 +477,18 @@ static int write_results(const options *o, int argc, char **argv, umbra_context 
     fprintf(f, "ms per frame, median / max, and over the unshadowed frame (median over median, "
                "max over max). camera: the camera orbits, the map is cached; light: the light "
                "orbits, every frame rebuilds; opacity: the transfer function changes every "
-               "frame; light-draft: the light orbits with map_texels_per_voxel 1, the draft an "
-               "application asks for while the user drags the light (CSSM and deep). build: the "
+               "frame; light-auto: the light orbits on a renderer with interaction auto, so "
+               "every frame builds the technique's draft (umbra_technique_info.draft; the "
+               "threshold map has none), and drafts counts the timed frames that did. build: the "
                "shadow build's part of the shadowed frame "
                "(umbra_render_stats.shadow_build_ms, device time; 0 where the map is re-used): "
-               "the rest of a frame is the ray caster and the read-back.\n\n");
+               "the rest of a frame is the ray caster and the read-back. stop: light-auto's "
+               "frame after the light stopped (the full map) and whether its image equals a "
+               "fresh renderer's full render bit for bit.\n\n");
     fprintf(f, "| scene | shading | technique | map | sequence | ms median | ms max | none "
-               "median | none max | × median | × max | build median |\n"
-               "|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+               "median | none max | × median | × max | build median | drafts | stop ms | stop "
+               "identical |\n"
+               "|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for (int i = 0; i < n; ++i) {
         const row *r = &rows[i];
         char map[32];
@@ -438,11 +496,16 @@ static int write_results(const options *o, int argc, char **argv, umbra_context 
             snprintf(map, sizeof map, "%u²", r->map_lo);
         else
             snprintf(map, sizeof map, "%u²–%u²", r->map_lo, r->map_hi);
-        fprintf(f, "| %s | %s | %s | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %.1f |\n",
+        char stop[64] = "| – | –";
+        if (r->stop_identical >= 0)
+            snprintf(stop, sizeof stop, "| %.1f | %s", r->stop_ms,
+                     r->stop_identical ? "yes" : "**no**");
+        fprintf(f, "| %s | %s | %s | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %.1f "
+                   "| %d %s |\n",
                 r->scene, r->shading ? "on" : "off", umbra_shadow_technique_name(r->technique),
                 map, sequence_names[r->seq], r->shadowed.median, r->shadowed.max,
                 r->none.median, r->none.max, r->shadowed.median / r->none.median,
-                r->shadowed.max / r->none.max, r->build.median);
+                r->shadowed.max / r->none.max, r->build.median, r->drafts, stop);
     }
     fclose(f);
     fprintf(stderr, "wrote %s/interactive.csv and %s/interactive.md\n", o->results, o->results);

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 /* bench/raycast.c: `umbra-bench raycast`, the foundation's speed check.
  *
- * One view of the bonsai CT (or its procedural stand-in, bench_util.c) at 512x512, view step 0.5
- * voxel, no shadows (technique none), no jitter, early ray termination at 0.99 and empty-space
- * skipping on, twice: without shading and with gradient Blinn-Phong shading (--shading or
- * --no-shading times one of the two), rendered by
+ * One view of each scene, the bonsai CT (or its procedural stand-in, bench_util.c; 8-bit) and the
+ * walnut CT (16-bit; skipped when its file is missing), at 512x512, view step 0.5 voxel, no
+ * shadows (technique none), no jitter, early ray termination at 0.99 and empty-space skipping on,
+ * twice: without shading and with gradient Blinn-Phong shading (--shading or --no-shading times
+ * one of the two), rendered by
  *   umbra     umbra_renderer_render on the OpenCL device (PoCL's CPU device here): device time of
  *             the kernel (stats.render_ms) and, as umbra_wall, the wall time of the whole call
  *             including the read-back of the image;
@@ -26,9 +27,11 @@
  *
  * The view (also in bench/README.md): a perspective camera with 30 degrees vertical field of
  * view, looking at the volume's centre from 1.5 box diagonals away along (0.35, 0.25, 1), y up
- * (the bonsai stands along +y). The transfer function: bonsai_tf below, the same control points
- * as bench/scenes/bonsai.tf (foliage translucent green, trunk brown, pot opaque), 256 entries,
- * alpha per voxel step. Ambient 0 and a white light make each sample's colour its table colour. */
+ * (the bonsai stands along +y). The transfer functions: bonsai_tf below, the same control points
+ * as bench/scenes/bonsai.tf (foliage translucent green, trunk brown, pot opaque), and walnut_tf,
+ * those of examples/walnut.tf (shell and kernel translucent), 256 entries, alpha per voxel step,
+ * over each volume's value range; VTK gets the same points. Ambient 0 and a white light make each
+ * sample's colour its table colour. The walnut's rows carry the prefix walnut_. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <signal.h>
@@ -59,7 +62,33 @@ static const umbra_tf_point bonsai_tf[] = {
     {0.72f, {0.80f, 0.45f, 0.30f, 0.50f}}, /* pot */
     {1.00f, {0.80f, 0.45f, 0.30f, 0.50f}},
 };
+/* examples/walnut.tf's points (bench/scenes/walnut.scene's transfer function). */
+static const umbra_tf_point walnut_tf[] = {
+    {0.00f, {0.00f, 0.00f, 0.00f, 0.00f}},
+    {0.20f, {0.95f, 0.85f, 0.50f, 0.00f}},
+    {0.24f, {0.95f, 0.85f, 0.50f, 0.03f}}, /* kernel */
+    {0.31f, {0.95f, 0.85f, 0.50f, 0.03f}},
+    {0.335f, {0.80f, 0.40f, 0.15f, 0.02f}},
+    {0.37f, {0.80f, 0.36f, 0.12f, 0.07f}}, /* shell */
+    {0.50f, {0.80f, 0.36f, 0.12f, 0.07f}},
+    {0.60f, {0.90f, 0.90f, 0.90f, 0.30f}}, /* rare dense specks */
+    {1.00f, {0.90f, 0.90f, 0.90f, 0.30f}},
+};
 enum { TF_RESOLUTION = 256 };
+
+/* A scene the benchmark times: its volume file (found as bench_find_volume does) and transfer
+ * function; prefix begins its rows' names. */
+typedef struct raycast_scene {
+    const char *name, *file, *prefix;
+    const umbra_tf_point *tf;
+    size_t tf_count;
+} raycast_scene;
+
+static const raycast_scene scenes[] = {
+    {"bonsai", "bonsai.nhdr", "", bonsai_tf, sizeof bonsai_tf / sizeof bonsai_tf[0]},
+    {"walnut", "walnut.nhdr", "walnut_", walnut_tf, sizeof walnut_tf / sizeof walnut_tf[0]},
+};
+enum { SCENES = sizeof scenes / sizeof scenes[0] };
 
 static const float view_dir[3] = {0.35f, 0.25f, 1.0f};
 static const float view_distance = 1.5f; /* box diagonals */
@@ -70,6 +99,7 @@ typedef struct options {
     uint32_t width, height;
     float step;
     const char *volume;
+    char scenes[64];
     int procedural;
     int vtk;
     const char *results;
@@ -86,6 +116,7 @@ static void usage(FILE *f)
             "  --warmup N       untimed warm-up runs (default 2)\n"
             "  --size WxH       image size (default 512x512)\n"
             "  --step S         view step in voxels (default 0.5)\n"
+            "  --scenes A,B     bonsai, walnut or both (default bonsai,walnut)\n"
             "  --volume FILE    volume instead of the bonsai (.nrrd/.nhdr/.dat)\n"
             "  --procedural     use the procedural 256^3 stand-in even if the bonsai is present\n"
             "  --shading        time only the shaded case (gradient Blinn-Phong)\n"
@@ -96,9 +127,9 @@ static void usage(FILE *f)
             "  --save PREFIX    write PREFIX_umbra.png, PREFIX_native_c.png (and _vtk.png)\n"
             "Prints CSV (" BENCH_CSV_HEADER ") on stdout: rows umbra (device time),\n"
             "umbra_wall, native_c and, when python3 imports vtk, vtk_fixedpoint (frames\n"
-            "interleaved with umbra's), each again with the suffix _shaded for the shaded case;\n"
-            "the ratio of umbra's samples/s to native_c's and of VTK's time per frame to\n"
-            "umbra's, per case, on stderr.\n");
+            "interleaved with umbra's), each again with the suffix _shaded for the shaded case,\n"
+            "and the walnut's the same with the prefix walnut_; the ratio of umbra's samples/s\n"
+            "to native_c's and of VTK's time per frame to umbra's, per case, on stderr.\n");
 }
 
 static int parse(int argc, char **argv, options *o)
@@ -108,6 +139,7 @@ static int parse(int argc, char **argv, options *o)
     o->width = o->height = 512;
     o->step = 0.5f;
     o->volume = NULL;
+    snprintf(o->scenes, sizeof o->scenes, "bonsai,walnut");
     o->procedural = 0;
     o->vtk = 1;
     o->results = NULL;
@@ -148,6 +180,21 @@ static int parse(int argc, char **argv, options *o)
             ++i;
         } else if (strcmp(a, "--volume") == 0 && v) {
             o->volume = v;
+            ++i;
+        } else if (strcmp(a, "--scenes") == 0 && v) {
+            for (const char *c = v; *c;) {
+                size_t n = strcspn(c, ",");
+                int known = 0;
+                for (int k = 0; k < SCENES; ++k)
+                    known |= strlen(scenes[k].name) == n && strncmp(c, scenes[k].name, n) == 0;
+                if (!known || n == 0) {
+                    fprintf(stderr, "umbra-bench raycast: --scenes '%s': need bonsai, walnut\n",
+                            v);
+                    return -1;
+                }
+                c += n + (c[n] == ',');
+            }
+            snprintf(o->scenes, sizeof o->scenes, "%s", v);
             ++i;
         } else if (strcmp(a, "--device") == 0 && v) {
             o->device = v;
@@ -226,9 +273,10 @@ typedef struct vtk_peer {
 } vtk_peer;
 
 /* Starts the script on the benchmark's view; 0 once it has set up and warmed up. */
-static int vtk_start(const options *o, const bench_volume *v, const umbra_camera *cam,
-                     const umbra_render_desc *shaded, const umbra_light *light, float step_world,
-                     vtk_peer *peer, char *why, size_t why_size)
+static int vtk_start(const options *o, const raycast_scene *sc, const bench_volume *v,
+                     const umbra_camera *cam, const umbra_render_desc *shaded,
+                     const umbra_light *light, float step_world, vtk_peer *peer, char *why,
+                     size_t why_size)
 {
     memset(peer, 0, sizeof *peer);
     peer->pid = -1;
@@ -246,13 +294,13 @@ static int vtk_start(const options *o, const bench_volume *v, const umbra_camera
     int xvfb = !(display && *display) && system("command -v xvfb-run >/dev/null 2>&1") == 0;
     char tf[1024] = "";
     size_t len = 0;
-    for (size_t i = 0; i < sizeof bonsai_tf / sizeof bonsai_tf[0] && len < sizeof tf; ++i)
+    for (size_t i = 0; i < sc->tf_count && len < sizeof tf; ++i)
         len += (size_t)snprintf(tf + len, sizeof tf - len, "%s%g,%g,%g,%g,%g", i ? ";" : "",
-                                bonsai_tf[i].value, bonsai_tf[i].rgba[0], bonsai_tf[i].rgba[1],
-                                bonsai_tf[i].rgba[2], bonsai_tf[i].rgba[3]);
+                                sc->tf[i].value, sc->tf[i].rgba[0], sc->tf[i].rgba[1],
+                                sc->tf[i].rgba[2], sc->tf[i].rgba[3]);
     char save[600] = "";
     if (o->save)
-        snprintf(save, sizeof save, " --save '%s_vtk.png'", o->save);
+        snprintf(save, sizeof save, " --save '%s_%svtk.png'", o->save, sc->prefix);
     char cmd[4096];
     snprintf(cmd, sizeof cmd,
              "exec %s'%s' '%s/bench/vtk_raycast.py' --serve --nrrd '%s' --size %u %u "
@@ -349,8 +397,11 @@ typedef struct row {
 /* One of the two views the benchmark times: without shading (the foundation's check) or with
  * gradient Blinn-Phong shading; everything else alike. */
 typedef struct bench_case {
+    const raycast_scene *scene;
+    const bench_volume *vol;
     int shading;
     const char *suffix; /* "" or "_shaded": appended to the row names */
+    char names[4][48];  /* the rows' names: the scene's prefix, the renderer, the suffix */
     umbra_renderer r;
     cpu_scene cs; /* cpu_prepare keeps a pointer to it */
     cpu_prepared *prepared;
@@ -377,9 +428,15 @@ static double load_average(void)
     return load;
 }
 
-static int write_results(const options *o, int argc, char **argv, const bench_volume *v,
-                         const char *device, const bench_case *cases, int ncases,
-                          const umbra_render_desc *shaded, const double load[2])
+/* The scenes' load averages (1 minute) before and after their frames. */
+typedef struct scene_load {
+    const raycast_scene *scene;
+    double before, after;
+} scene_load;
+
+static int write_results(const options *o, int argc, char **argv, const char *device,
+                         const bench_case *cases, int ncases, const umbra_render_desc *shaded,
+                         const scene_load *loads, int nscenes)
 {
     FILE *f = bench_results_open(o->results, "raycast", "csv");
     if (!f)
@@ -397,8 +454,16 @@ static int write_results(const options *o, int argc, char **argv, const bench_vo
 #else
     fprintf(f, "- native C: built without OpenMP (1 thread)\n");
 #endif
-    fprintf(f, "- volume: %s (%u x %u x %u)\n", v->description, v->dims[0], v->dims[1],
-            v->dims[2]);
+    for (int c = 0; c < ncases; ++c)
+        if (c == 0 || cases[c].vol != cases[c - 1].vol)
+            fprintf(f, "- volume%s%s: %s (%u x %u x %u), transfer function: %s (bench/raycast.c)\n",
+                    cases[c].scene->prefix[0] ? " of the rows " : "",
+                    cases[c].scene->prefix[0] ? cases[c].scene->prefix : "",
+                    cases[c].vol->description, cases[c].vol->dims[0], cases[c].vol->dims[1],
+                    cases[c].vol->dims[2],
+                    strcmp(cases[c].scene->name, "walnut") == 0 ? "examples/walnut.tf's points"
+                                                                : "bench/scenes/bonsai.tf's "
+                                                                  "points");
     fprintf(f, "- view: %ux%u, step %g voxel, no shadows, early termination 0.99, empty-space "
                "skipping (camera and transfer function: bench/README.md)\n",
             o->width, o->height, o->step);
@@ -407,13 +472,16 @@ static int write_results(const options *o, int argc, char **argv, const bench_vo
                "same coefficients and light)\n",
             shaded->kd, shaded->ks, shaded->shininess);
     fprintf(f, "- medians of %d frames after %d warm-up frames; umbra, native C and VTK take "
-               "turns frame by frame, unshaded and shaded in the same turn\n",
+               "turns frame by frame, unshaded and shaded in the same turn, one scene after the "
+               "other\n",
             o->runs, o->warmup);
-    if (load[0] >= 0.0 && load[1] >= 0.0)
-        fprintf(f, "- load average (1 minute) before / after the frames: %.1f / %.1f (the three "
-                   "renderers use every CPU; a load above that means other processes shared "
-                   "the machine: compare the ratios of one run, not times across runs)\n",
-                load[0], load[1]);
+    for (int k = 0; k < nscenes; ++k)
+        if (loads[k].before >= 0.0 && loads[k].after >= 0.0)
+            fprintf(f, "- load average (1 minute) before / after the %s's frames: %.1f / %.1f "
+                       "(the three renderers use every CPU; a load above that means other "
+                       "processes shared the machine: compare the ratios of one run, not times "
+                       "across runs)\n",
+                    loads[k].scene->name, loads[k].before, loads[k].after);
     fprintf(f, "\n");
     fprintf(f, "| case | ms median | samples/s | samples | ms min | ms max |\n"
                "|---|---:|---:|---:|---:|---:|\n");
@@ -432,8 +500,8 @@ static int write_results(const options *o, int argc, char **argv, const bench_vo
     for (int c = 0; c < ncases; ++c) {
         const bench_case *bc = &cases[c];
         const char *what = bc->shading ? "shaded" : "unshaded";
-        fprintf(f, "%s: umbra / native C samples per second **%.2f** (target >= 0.9)", what,
-                bc->ratio);
+        fprintf(f, "%s, %s: umbra / native C samples per second **%.2f** (target >= 0.9)",
+                bc->scene->name, what, bc->ratio);
         if (bc->vtk_ratio > 0.0)
             fprintf(f, "; VTK / umbra time per frame **%.2f** (target %s)", bc->vtk_ratio,
                     bc->shading ? ">= 1.0" : ">= 1.2");
@@ -574,15 +642,16 @@ static int six_sample_diff(const bench_case *bc, const options *o, double *diff)
     return 0;
 }
 
-/* The row names of a case: base name plus the case's suffix, in static storage per case. */
-static const char *row_name(char (*names)[40], int slot, const char *base, const char *suffix)
+/* A case's row name: the scene's prefix, base and the case's suffix, in the case's storage. */
+static const char *row_name(bench_case *bc, int slot, const char *base)
 {
-    snprintf(names[slot], sizeof names[slot], "%s%s", base, suffix);
-    return names[slot];
+    snprintf(bc->names[slot], sizeof bc->names[slot], "%s%s%s", bc->scene->prefix, base,
+             bc->suffix);
+    return bc->names[slot];
 }
 
 /* Fills a case's rows and ratios after its timed frames, and reports them on stderr. */
-static void case_report(bench_case *bc, const options *o, int vtk_ran, char (*names)[40])
+static void case_report(bench_case *bc, const options *o, int vtk_ran)
 {
     size_t npix = (size_t)o->width * o->height;
     bc->diff = 0.0;
@@ -590,17 +659,16 @@ static void case_report(bench_case *bc, const options *o, int vtk_ran, char (*na
         double d = fabs((double)bc->img_umbra[i] - (double)bc->img_native[i]);
         bc->diff = d > bc->diff ? d : bc->diff;
     }
-    const char *sfx = bc->suffix;
     bc->nrows = 0;
-    bc->rows[bc->nrows++] = (row){row_name(names, 0, "umbra", sfx),
-                                  bench_timing_of(bc->t_dev, o->runs), bc->samples_umbra};
-    bc->rows[bc->nrows++] = (row){row_name(names, 1, "umbra_wall", sfx),
+    bc->rows[bc->nrows++] = (row){row_name(bc, 0, "umbra"), bench_timing_of(bc->t_dev, o->runs),
+                                  bc->samples_umbra};
+    bc->rows[bc->nrows++] = (row){row_name(bc, 1, "umbra_wall"),
                                   bench_timing_of(bc->t_wall, o->runs), bc->samples_umbra};
-    bc->rows[bc->nrows++] = (row){row_name(names, 2, "native_c", sfx),
+    bc->rows[bc->nrows++] = (row){row_name(bc, 2, "native_c"),
                                   bench_timing_of(bc->t_native, o->runs), bc->samples_native};
     bc->vtk_ratio = 0.0;
     if (vtk_ran) {
-        bc->rows[bc->nrows++] = (row){row_name(names, 3, "vtk_fixedpoint", sfx),
+        bc->rows[bc->nrows++] = (row){row_name(bc, 3, "vtk_fixedpoint"),
                                       bench_timing_of(bc->t_vtk, o->runs), 0};
         bc->vtk_ratio = bc->rows[3].t.median / bc->rows[0].t.median;
     }
@@ -608,21 +676,188 @@ static void case_report(bench_case *bc, const options *o, int vtk_ran, char (*na
     double sps_native = (double)bc->samples_native / bc->rows[2].t.median;
     bc->ratio = sps_umbra / sps_native;
     const char *what = bc->shading ? "shaded" : "unshaded";
+    const char *scene = bc->scene->name;
     if (bc->diff_six >= 0.0)
-        fprintf(stderr, "shaded: umbra vs the C twin shading as before issue #12 (six-sample "
-                        "gradient, powf): largest pixel difference %.2e\n", bc->diff_six);
+        fprintf(stderr, "%s, shaded: umbra vs the C twin shading as before issue #12 (six-sample "
+                        "gradient, powf): largest pixel difference %.2e\n", scene, bc->diff_six);
     /* Both take the same samples up to float rounding: a last-bit difference in a ray's
      * direction (OpenCL's normalize() against the C twin's 1/sqrtf) can move a sample across a
      * brick face or the ray's end, so a few rays in a million take one sample more or less. */
-    fprintf(stderr, "%s: umbra vs native C: samples %llu vs %llu (%+.1e relative), largest pixel "
-                    "difference %.2e\n",
-            what, (unsigned long long)bc->samples_umbra, (unsigned long long)bc->samples_native,
+    fprintf(stderr, "%s, %s: umbra vs native C: samples %llu vs %llu (%+.1e relative), largest "
+                    "pixel difference %.2e\n",
+            scene, what, (unsigned long long)bc->samples_umbra,
+            (unsigned long long)bc->samples_native,
             ((double)bc->samples_umbra - (double)bc->samples_native) / (double)bc->samples_native,
             bc->diff);
-    fprintf(stderr, "%s: ratio umbra/native_c samples/s: %.3f (target >= 0.9)\n", what, bc->ratio);
+    fprintf(stderr, "%s, %s: ratio umbra/native_c samples/s: %.3f (target >= 0.9)\n", scene, what,
+            bc->ratio);
     if (bc->vtk_ratio > 0.0)
-        fprintf(stderr, "%s: ratio vtk_fixedpoint/umbra ms per frame: %.3f (target %s)\n", what,
-                bc->vtk_ratio, bc->shading ? ">= 1.0" : ">= 1.2");
+        fprintf(stderr, "%s, %s: ratio vtk_fixedpoint/umbra ms per frame: %.3f (target %s)\n",
+                scene, what, bc->vtk_ratio, bc->shading ? ">= 1.0" : ">= 1.2");
+}
+
+/* The walnut's file: $UMBRA_DATA_DIR/NAME or $UMBRA_DATA_DIR/volumes/NAME, else
+ * UMBRA_SOURCE_DIR/../shared/data/volumes/NAME; 0 and the path in out if one exists. */
+static int find_volume(const char *name, char *out, size_t size)
+{
+    const char *data_dir = getenv("UMBRA_DATA_DIR");
+    char c[3][1100];
+    int n = 0;
+    if (data_dir && *data_dir) {
+        snprintf(c[n++], sizeof c[0], "%s/%s", data_dir, name);
+        snprintf(c[n++], sizeof c[0], "%s/volumes/%s", data_dir, name);
+    }
+    snprintf(c[n++], sizeof c[0], "%s/../shared/data/volumes/%s", UMBRA_SOURCE_DIR, name);
+    for (int i = 0; i < n; ++i) {
+        FILE *f = fopen(c[i], "rb");
+        size_t len = strlen(c[i]);
+        if (f) {
+            fclose(f);
+            if (len >= size)
+                return -1;
+            memcpy(out, c[i], len + 1);
+            return 0;
+        }
+    }
+    return -1;
+}
+
+/* One scene: its volume, transfer function and cases (unshaded, shaded, as o->shading says)
+ * appended to cases[*ncases], VTK started for it, warm-up and timed frames in turn, the rows
+ * reported. 1 when the scene was skipped (its volume is missing), -1 on failure. */
+static int run_scene(umbra_context ctx, const options *o, const raycast_scene *sc,
+                     bench_volume *vol, bench_case *cases, int *ncases,
+                     const umbra_render_desc *ro, const umbra_render_desc *ro_shaded,
+                     scene_load *load)
+{
+    int status = -1;
+    umbra_transfer_function tf = NULL;
+    vtk_peer peer = {-1, NULL, NULL};
+    int vtk_running = 0;
+    const int first = *ncases;
+    if (strcmp(sc->name, "bonsai") == 0) {
+        if (bench_volume_load_bonsai(ctx, o->volume, o->procedural, vol) != 0)
+            return -1;
+    } else {
+        char path[1100];
+        if (find_volume(sc->file, path, sizeof path) != 0) {
+            fprintf(stderr, "%s: skipped: %s not found (set UMBRA_DATA_DIR)\n", sc->name,
+                    sc->file);
+            return 1;
+        }
+        if (bench_volume_load_bonsai(ctx, path, 0, vol) != 0)
+            return -1;
+    }
+    umbra_camera cam = bench_camera(vol);
+    umbra_light light;
+    memset(&light, 0, sizeof light);
+    light.type = UMBRA_LIGHT_DIRECTIONAL;
+    light.direction[1] = -1.0f;
+    light.color[0] = light.color[1] = light.color[2] = 1.0f;
+    umbra_shadow_desc sh;
+    umbra_shadow_desc_init(&sh);
+    sh.technique = UMBRA_SHADOW_NONE;
+    if (umbra_transfer_function_create_from_points(ctx, sc->tf, sc->tf_count, TF_RESOLUTION,
+                                                   &tf) != UMBRA_SUCCESS) {
+        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
+        goto done;
+    }
+    for (int shading = 0; shading < 2; ++shading) {
+        if (o->shading >= 0 && o->shading != shading)
+            continue;
+        bench_case *bc = &cases[(*ncases)++];
+        bc->scene = sc;
+        bc->vol = vol;
+        bc->shading = shading;
+        bc->suffix = shading ? "_shaded" : "";
+        if (case_setup(ctx, o, vol, tf, &cam, &light, shading ? ro_shaded : ro, &sh, bc) != 0)
+            goto done;
+    }
+    bench_case *cs = cases + first;
+    const int n = *ncases - first;
+
+    /* VTK in its own process, set up and warmed up (with and without shading, so that its
+     * gradient encoding is done) before the timed frames. */
+    if (o->vtk) {
+        char why[256];
+        float voxel = fminf(vol->spacing[0], fminf(vol->spacing[1], vol->spacing[2]));
+        signal(SIGPIPE, SIG_IGN); /* a peer that dies shows as a failed write, not a signal */
+        if (vtk_start(o, sc, vol, &cam, ro_shaded, &light, o->step * voxel, &peer, why,
+                      sizeof why) == 0)
+            vtk_running = 1;
+        else
+            fprintf(stderr, "%s: vtk_fixedpoint: skipped: %s\n", sc->name, why);
+        if (!vtk_running)
+            vtk_stop(&peer);
+    }
+
+    /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, both
+     * cases in each turn, so that a change in the machine's load (other processes) during the
+     * measurement touches all alike. */
+    double dev, wall;
+    load->scene = sc;
+    load->before = load_average();
+    for (int i = 0; i < o->warmup; ++i)
+        for (int c = 0; c < n; ++c) {
+            bench_case *bc = &cs[c];
+            if (umbra_frame(ctx, bc->r, o, bc->img_umbra, &dev, &wall, &bc->samples_umbra) != 0)
+                goto done;
+            bc->samples_native = cpu_render_prepared(bc->prepared, o->width, o->height,
+                                                     bc->img_native);
+        }
+    for (int i = 0; i < o->runs; ++i)
+        for (int c = 0; c < n; ++c) {
+            bench_case *bc = &cs[c];
+            if (umbra_frame(ctx, bc->r, o, bc->img_umbra, &bc->t_dev[i], &bc->t_wall[i],
+                            &bc->samples_umbra) != 0)
+                goto done;
+            double t0 = bench_now_ms();
+            bc->samples_native = cpu_render_prepared(bc->prepared, o->width, o->height,
+                                                     bc->img_native);
+            bc->t_native[i] = bench_now_ms() - t0;
+            if (vtk_running && (bc->t_vtk[i] = vtk_frame(&peer, bc->shading)) < 0.0) {
+                fprintf(stderr, "%s: vtk_fixedpoint: dropped: bench/vtk_raycast.py stopped "
+                                "answering\n", sc->name);
+                vtk_stop(&peer);
+                vtk_running = 0;
+            }
+        }
+    load->after = load_average();
+    if (vtk_running && vtk_stop(&peer) != 0)
+        fprintf(stderr, "%s: vtk_fixedpoint: bench/vtk_raycast.py exited with an error\n",
+                sc->name);
+    for (int c = 0; c < n; ++c) {
+        cs[c].diff_six = -1.0;
+        if (cs[c].shading && six_sample_diff(&cs[c], o, &cs[c].diff_six) != 0)
+            goto done;
+        case_report(&cs[c], o, vtk_running);
+    }
+    if (o->save)
+        for (int c = 0; c < n; ++c) {
+            char n_umbra[64], n_native[64];
+            snprintf(n_umbra, sizeof n_umbra, "%sumbra%s", sc->prefix, cs[c].suffix);
+            snprintf(n_native, sizeof n_native, "%snative_c%s", sc->prefix, cs[c].suffix);
+            save_png(ctx, o->save, n_umbra, o->width, o->height, cs[c].img_umbra);
+            save_png(ctx, o->save, n_native, o->width, o->height, cs[c].img_native);
+        }
+    status = 0;
+done:
+    if (vtk_running)
+        vtk_stop(&peer);
+    umbra_transfer_function_release(tf);
+    return status;
+}
+
+static int scene_selected(const options *o, const char *name)
+{
+    size_t n = strlen(name);
+    for (const char *c = o->scenes; *c;) {
+        size_t k = strcspn(c, ",");
+        if (k == n && strncmp(c, name, n) == 0)
+            return 1;
+        c += k + (c[k] == ',');
+    }
+    return 0;
 }
 
 int bench_raycast(int argc, char **argv)
@@ -634,107 +869,29 @@ int bench_raycast(int argc, char **argv)
     umbra_context ctx = bench_context(o.device);
     if (!ctx)
         return 1;
-    bench_volume vol;
-    umbra_transfer_function tf = NULL;
-    bench_case cases[2];
-    int ncases = 0;
+    bench_volume vols[SCENES];
+    bench_case cases[2 * SCENES];
+    scene_load loads[SCENES];
+    int ncases = 0, nscenes = 0;
+    memset(vols, 0, sizeof vols);
     memset(cases, 0, sizeof cases);
-    vtk_peer peer = {-1, NULL, NULL};
-    int vtk_running = 0;
     char device[700];
-    char names[2][4][40];
     bench_device_description(ctx, device, sizeof device);
-    if (bench_volume_load_bonsai(ctx, o.volume, o.procedural, &vol) != 0)
-        goto done;
     fprintf(stderr, "device: %s\n", device);
-
-    umbra_camera cam = bench_camera(&vol);
-    umbra_light light;
-    memset(&light, 0, sizeof light);
-    light.type = UMBRA_LIGHT_DIRECTIONAL;
-    light.direction[1] = -1.0f;
-    light.color[0] = light.color[1] = light.color[2] = 1.0f;
     umbra_render_desc ro;
     umbra_render_desc_init(&ro);
     ro.step = o.step;
     ro.ambient[0] = ro.ambient[1] = ro.ambient[2] = 0.0f;
     umbra_render_desc ro_shaded = ro;
     ro_shaded.shading = 1; /* kd, ks, shininess: the defaults */
-    umbra_shadow_desc sh;
-    umbra_shadow_desc_init(&sh);
-    sh.technique = UMBRA_SHADOW_NONE;
-    if (umbra_transfer_function_create_from_points(ctx, bonsai_tf,
-                                                   sizeof bonsai_tf / sizeof bonsai_tf[0],
-                                                   TF_RESOLUTION, &tf) != UMBRA_SUCCESS) {
-        fprintf(stderr, "umbra-bench raycast: %s\n", umbra_context_last_message(ctx));
-        goto done;
-    }
-    if (o.shading != 1) {
-        cases[ncases].shading = 0;
-        cases[ncases].suffix = "";
-        if (case_setup(ctx, &o, &vol, tf, &cam, &light, &ro, &sh, &cases[ncases++]) != 0)
+    for (int k = 0; k < SCENES; ++k) {
+        if (!scene_selected(&o, scenes[k].name))
+            continue;
+        int rc = run_scene(ctx, &o, &scenes[k], &vols[k], cases, &ncases, &ro, &ro_shaded,
+                           &loads[nscenes]);
+        if (rc < 0)
             goto done;
-    }
-    if (o.shading != 0) {
-        cases[ncases].shading = 1;
-        cases[ncases].suffix = "_shaded";
-        if (case_setup(ctx, &o, &vol, tf, &cam, &light, &ro_shaded, &sh, &cases[ncases++]) != 0)
-            goto done;
-    }
-
-    /* VTK in its own process, set up and warmed up (with and without shading, so that its
-     * gradient encoding is done) before the timed frames. */
-    if (o.vtk) {
-        char why[256];
-        float voxel = fminf(vol.spacing[0], fminf(vol.spacing[1], vol.spacing[2]));
-        signal(SIGPIPE, SIG_IGN); /* a peer that dies shows as a failed write, not a signal */
-        if (vtk_start(&o, &vol, &cam, &ro_shaded, &light, o.step * voxel, &peer, why,
-                      sizeof why) == 0)
-            vtk_running = 1;
-        else
-            fprintf(stderr, "vtk_fixedpoint: skipped: %s\n", why);
-        if (!vtk_running)
-            vtk_stop(&peer);
-    }
-
-    /* Warm-up, then the timed frames: umbra, native C and VTK take turns frame by frame, both
-     * cases in each turn, so that a change in the machine's load (other processes) during the
-     * measurement touches all alike. */
-    double dev, wall, load[2];
-    load[0] = load_average();
-    for (int i = 0; i < o.warmup; ++i)
-        for (int c = 0; c < ncases; ++c) {
-            bench_case *bc = &cases[c];
-            if (umbra_frame(ctx, bc->r, &o, bc->img_umbra, &dev, &wall, &bc->samples_umbra) != 0)
-                goto done;
-            bc->samples_native = cpu_render_prepared(bc->prepared, o.width, o.height,
-                                                     bc->img_native);
-        }
-    for (int i = 0; i < o.runs; ++i)
-        for (int c = 0; c < ncases; ++c) {
-            bench_case *bc = &cases[c];
-            if (umbra_frame(ctx, bc->r, &o, bc->img_umbra, &bc->t_dev[i], &bc->t_wall[i],
-                            &bc->samples_umbra) != 0)
-                goto done;
-            double t0 = bench_now_ms();
-            bc->samples_native = cpu_render_prepared(bc->prepared, o.width, o.height,
-                                                     bc->img_native);
-            bc->t_native[i] = bench_now_ms() - t0;
-            if (vtk_running && (bc->t_vtk[i] = vtk_frame(&peer, bc->shading)) < 0.0) {
-                fprintf(stderr, "vtk_fixedpoint: dropped: bench/vtk_raycast.py stopped answering\n");
-                vtk_stop(&peer);
-                vtk_running = 0;
-            }
-        }
-    load[1] = load_average();
-    if (vtk_running && vtk_stop(&peer) != 0)
-        fprintf(stderr, "vtk_fixedpoint: bench/vtk_raycast.py exited with an error\n");
-
-    for (int c = 0; c < ncases; ++c) {
-        cases[c].diff_six = -1.0;
-        if (cases[c].shading && six_sample_diff(&cases[c], &o, &cases[c].diff_six) != 0)
-            goto done;
-        case_report(&cases[c], &o, vtk_running, names[c]);
+        nscenes += rc == 0;
     }
     printf("%s\n", BENCH_CSV_HEADER);
     for (int c = 0; c < ncases; ++c)
@@ -742,24 +899,14 @@ int bench_raycast(int argc, char **argv)
             bench_csv_row(stdout, cases[c].rows[i].name, cases[c].rows[i].t,
                           cases[c].rows[i].samples);
     fflush(stdout);
-    if (o.save)
-        for (int c = 0; c < ncases; ++c) {
-            char n_umbra[40], n_native[40];
-            snprintf(n_umbra, sizeof n_umbra, "umbra%s", cases[c].suffix);
-            snprintf(n_native, sizeof n_native, "native_c%s", cases[c].suffix);
-            save_png(ctx, o.save, n_umbra, o.width, o.height, cases[c].img_umbra);
-            save_png(ctx, o.save, n_native, o.width, o.height, cases[c].img_native);
-        }
     /* A results file that cannot be written fails the run (the message is on stderr). */
-    status = o.results && write_results(&o, argc, argv, &vol, device, cases, ncases, &ro_shaded,
-                                        load) != 0;
+    status = o.results && write_results(&o, argc, argv, device, cases, ncases, &ro_shaded, loads,
+                                        nscenes) != 0;
 done:
-    if (vtk_running)
-        vtk_stop(&peer);
-    for (int c = 0; c < 2; ++c)
+    for (int c = 0; c < 2 * SCENES; ++c)
         case_free(&cases[c]);
-    umbra_transfer_function_release(tf);
-    bench_volume_free(&vol);
+    for (int k = 0; k < SCENES; ++k)
+        bench_volume_free(&vols[k]);
     umbra_context_release(ctx);
     return status;
 }

@@ -223,6 +223,7 @@ int session_begin(const options *o, session *s)
     if (o->colored >= 0) rd.transmission = o->colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
     rd.jitter = o->jitter;
     rd.preintegrated = o->preintegrated;
+    rd.interaction = o->interaction;
     rd.mode = o->mode;
     if (o->have_seed) rd.seed = o->seed;
     if (o->have_background) memcpy(rd.background, o->background, sizeof rd.background);
@@ -297,7 +298,8 @@ static int run(const options *o, session *s)
     fprintf(stderr, "technique: %s (%u light channel%s)\n",
             umbra_shadow_technique_name(o->shadow.technique), stats.light_channels,
             stats.light_channels == 1 ? "" : "s");
-    fprintf(stderr, "shadow build: %.2f ms\n", stats.shadow_build_ms);
+    fprintf(stderr, "shadow build: %.2f ms%s\n", stats.shadow_build_ms,
+            stats.draft ? " (draft)" : "");
     fprintf(stderr, "render: %.2f ms (%llu samples)\n", stats.render_ms,
             (unsigned long long)stats.samples);
     fprintf(stderr, "shadow memory: %zu bytes\n", stats.shadow_memory_bytes);

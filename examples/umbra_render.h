@@ -31,6 +31,8 @@ typedef struct options {
     int have_tf_range;
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
     int preintegrated;
+    umbra_interaction interaction;                                  /* --interaction */
+    int have_interaction;                                           /* --interaction given */
     int progress;                                                   /* -1: when a terminal */
     uint32_t seed;
     umbra_shadow_desc shadow; /* the technique and every parameter given (registry keys) */

@@ -151,7 +151,7 @@ enum {
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_ORTHO, OPT_LIGHT_DIR, OPT_LIGHT_POS,
     OPT_LIGHT_COLOR, OPT_AMBIENT, OPT_STEP, OPT_SHADING, OPT_NO_SHADING, OPT_GROUND,
     OPT_NO_GROUND, OPT_COLORED, OPT_GREY, OPT_BACKGROUND, OPT_JITTER, OPT_SEED, OPT_PREINTEGRATED,
-    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_MODE, OPT_CLIP_PLANE, OPT_CROP,
+    OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION, OPT_MODE, OPT_CLIP_PLANE, OPT_CROP,
     OPT_RAW_CHANNELS, OPT_LABELS, OPT_CHANNEL_TF,
     OPT_PARAM = 1024,  /* + the index of a technique option */
     OPT_PROGRAM = 2048 /* + the index of an option of the program's own (parse_args_as) */
@@ -227,6 +227,9 @@ static const fixed_option fixed[] = {
     {"seed", OPT_SEED, "N", "seed for the jitter and the stochastic maps (cssm's seed)"},
     {"preintegrated", OPT_PREINTEGRATED, NULL, "pre-integrated segments: the view ray's, and the "
                                                "convolution technique's light"},
+    {"interaction", OPT_INTERACTION, "MODE", "off (default) or auto: a frame after a light or "
+                                             "transfer-function change uses the technique's "
+                                             "draft, the next unchanged one the full map"},
     {"mode", OPT_MODE, "NAME", "render mode: composite (default: lit, shadowed), mip, minip or "
                                "average (intensity projections, unlit: technique none)"},
     {"clip-plane", OPT_CLIP_PLANE, "A,B,C,D", "keep the side a x + b y + c z + d >= 0 of a plane "
@@ -759,6 +762,15 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
         case OPT_GREY: o->colored = 0; break;
         case OPT_JITTER: o->jitter = 1; break;
         case OPT_PREINTEGRATED: o->preintegrated = 1; break;
+        case OPT_INTERACTION:
+            o->have_interaction = 1;
+            if (strcmp(v, "off") == 0)
+                o->interaction = UMBRA_INTERACTION_OFF;
+            else if (strcmp(v, "auto") == 0)
+                o->interaction = UMBRA_INTERACTION_AUTO;
+            else
+                FAIL("--interaction '%s' is neither off nor auto", v);
+            break;
         case OPT_SEED:
             if (!parse_uint(v, &o->seed))
                 FAIL("--seed '%s' is not a whole number", v);

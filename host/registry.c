@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "renderer_internal.h"
@@ -369,7 +370,8 @@ umbra_status umbra__validate_shadow(umbra_renderer r, const umbra__technique *t,
     return t->validate ? t->validate(r, d) : UMBRA_SUCCESS;
 }
 
-void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t, umbra__light_key *key)
+void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t,
+                           const umbra_shadow_desc *desc, umbra__light_key *key)
 {
     const uint32_t by = t->info.rebuilt_by;
     memset(key, 0, sizeof *key);
@@ -393,7 +395,94 @@ void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t, umbra__l
         key->skip_empty = r->opts.empty_space_skipping;
     for (uint32_t k = 0, n = 0; k < t->info.param_count && n < UMBRA__MAX_PARAMS; ++k)
         if (t->params[k].info.flags & UMBRA_PARAM_REBUILDS)
-            key->params[n++] = value_of(&t->params[k], &r->shadow);
+            key->params[n++] = value_of(&t->params[k], desc);
+}
+
+/* ---- drafts ---------------------------------------------------------------------------------- */
+
+/* The value a zero of p stands for in a draft's comparison: a map's texels per voxel or step
+ * "the technique's own" is the technique's; any other zero ("unbounded") is infinite. */
+static double zero_means(const umbra__technique *t, const umbra__param *p)
+{
+    if (p->offset == offsetof(umbra_shadow_desc, map.texels_per_voxel))
+        return t->info.map_texels_per_voxel;
+    if (p->offset == offsetof(umbra_shadow_desc, map.step))
+        return t->info.map_step;
+    return INFINITY;
+}
+
+/* Applies one "key<=v", "key>=v" or "key=v" of a draft string to d; 0 if it does not parse, names
+ * no parameter of t, or gives a value the parameter refuses. */
+static int apply_draft_term(const umbra__technique *t, const char *term, size_t len,
+                            umbra_shadow_desc *d)
+{
+    char buf[96];
+    if (len == 0 || len >= sizeof buf)
+        return 0;
+    memcpy(buf, term, len);
+    buf[len] = '\0';
+    char *eq = strchr(buf, '=');
+    if (!eq || eq == buf)
+        return 0;
+    char op = '=';
+    if (eq[-1] == '<' || eq[-1] == '>') {
+        op = eq[-1];
+        eq[-1] = '\0';
+    }
+    *eq = '\0';
+    const umbra__param *p = param_find(t, buf);
+    if (!p)
+        return 0;
+    char *end;
+    double v = strtod(eq + 1, &end);
+    if (p->info.zero_name && strcmp(eq + 1, p->info.zero_name) == 0)
+        v = 0.0;
+    else if (end == eq + 1 || *end)
+        return 0;
+    if (op != '=') {
+        const double z = (p->info.flags & UMBRA_PARAM_ZERO) ? zero_means(t, p) : 0.0;
+        double have = value_of(p, d);
+        if ((p->info.flags & UMBRA_PARAM_ZERO) && have == 0.0)
+            have = z;
+        double want = op == '<' ? fmin(have, v) : fmax(have, v);
+        if (want == have)
+            return 1; /* the full setting is already as coarse: kept as the application set it */
+        v = want;
+    }
+    if (!in_range(p, v))
+        return 0;
+    store(p, d, v);
+    return 1;
+}
+
+int umbra__draft_desc(const umbra__technique *t, const umbra_shadow_desc *desc,
+                      umbra_shadow_desc *out)
+{
+    *out = *desc;
+    const char *s = t->info.draft;
+    if (!s)
+        return 0;
+    while (*s) {
+        size_t len = strcspn(s, ";");
+        if (!apply_draft_term(t, s, len, out)) {
+            *out = *desc;
+            return 0;
+        }
+        s += len + (s[len] == ';');
+    }
+    /* A fixed map size: the draft's texels per voxel scale it (the full map's are the
+     * technique's own there). */
+    const float k = out->map.texels_per_voxel, k_full = desc->map.texels_per_voxel;
+    if ((t->info.flags & UMBRA_TECHNIQUE_MAP) && desc->map.size != UMBRA_MAP_SIZE_AUTO &&
+        k != k_full && k > 0.0f && t->info.map_texels_per_voxel > 0.0f) {
+        const uint32_t n = desc->map.size, q = UMBRA_MAP_SIZE_AUTO_ROUND;
+        double want = ceil((double)n * k / t->info.map_texels_per_voxel);
+        uint32_t m = want >= (double)n ? n : ((uint32_t)want + q - 1) / q * q;
+        m = m < UMBRA_MAP_SIZE_AUTO_MIN ? UMBRA_MAP_SIZE_AUTO_MIN : m;
+        out->map.size = m < n ? m : n;
+        out->map.texels_per_voxel = k_full;
+    }
+    return memcmp(out, desc, sizeof *out) != 0;
 }
 
 size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,

@@ -18,6 +18,13 @@
 
 /* ---- defaults ---------------------------------------------------------------------------------- */
 
+/* umbra 0.5.0's umbra_render_desc ended with preintegrated: its size, padding included. */
+#define RENDER_DESC_SIZE_0_5                                                                   \
+    ((offsetof(umbra_render_desc, preintegrated) + sizeof(int) + _Alignof(umbra_render_desc) -  \
+      1) / _Alignof(umbra_render_desc) * _Alignof(umbra_render_desc))
+_Static_assert(sizeof(umbra_render_desc) != RENDER_DESC_SIZE_0_5,
+               "this layout and umbra 0.5.0's must differ in size");
+
 void umbra_render_desc_init(umbra_render_desc *d)
 {
     if (!d)
@@ -53,6 +60,7 @@ umbra_status umbra_renderer_create(umbra_context ctx, umbra_renderer *out)
     umbra_context_retain(ctx);
     umbra_render_desc_init(&r->opts);
     umbra_shadow_desc_init(&r->shadow);
+    r->shadow_set = r->shadow;
     r->tech = umbra__technique_by_id(UMBRA_SHADOW_NONE);
     r->light.type = UMBRA_LIGHT_DIRECTIONAL;
     r->light.direction[0] = -0.5f;
@@ -298,14 +306,18 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
     if (!d)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", fn);
     /* umbra 0.4's layout ends before preintegrated, which such a caller sets through its shadow
-     * description (umbra_renderer_set_shadow): it keeps its value. */
+     * description (umbra_renderer_set_shadow): it keeps its value. umbra 0.5.0's ends with
+     * preintegrated: the fields after it (interaction) keep theirs. */
     const size_t size_0_4 = offsetof(umbra_render_desc, preintegrated);
-    const size_t size_0_5 = offsetof(umbra_render_desc, mode);
-    if (d->struct_size != sizeof *d && d->struct_size != size_0_4 && d->struct_size != size_0_5)
+    /* umbra 0.5's layout ends with preintegrated: its size with its padding, or without it
+     * (offsetof mode). */
+    const size_t size_0_5 = RENDER_DESC_SIZE_0_5, end_0_5 = offsetof(umbra_render_desc, mode);
+    if (d->struct_size != sizeof *d && d->struct_size != size_0_5 && d->struct_size != end_0_5 &&
+        d->struct_size != size_0_4)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: desc->struct_size %zu is none of %zu, umbra 0.5's %zu and umbra "
-                           "0.4's %zu: call umbra_render_desc_init", fn, d->struct_size,
-                           sizeof *d, size_0_5, size_0_4);
+                           "%s: desc->struct_size %zu is none of %zu, umbra 0.5's %zu (%zu "
+                           "without padding) and umbra 0.4's %zu: call umbra_render_desc_init",
+                           fn, d->struct_size, sizeof *d, size_0_5, end_0_5, size_0_4);
     if (d->struct_size == sizeof *d && (unsigned)d->mode > UMBRA_RENDER_AVERAGE)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: mode %d is unknown (0 composite, 1 mip, 2 minip, 3 average)", fn,
@@ -337,11 +349,25 @@ umbra_status umbra_renderer_set_options(umbra_renderer r, const umbra_render_des
     if (d->transmission != UMBRA_TRANSMISSION_GREY && d->transmission != UMBRA_TRANSMISSION_COLORED)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: transmission %d is unknown",
                            fn, (int)d->transmission);
+    if (d->struct_size == sizeof *d && d->interaction != UMBRA_INTERACTION_OFF &&
+        d->interaction != UMBRA_INTERACTION_AUTO)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: interaction %d is unknown (UMBRA_INTERACTION_OFF 0 or _AUTO 1)", fn,
+                           (int)d->interaction);
     const int preintegrated = r->opts.preintegrated;
-    memcpy(&r->opts, d, d->struct_size);
+    const umbra_render_mode mode = r->opts.mode;
+    const umbra_interaction interaction = r->opts.interaction;
+    /* An older layout's bytes up to its last field, never its padding. */
+    memcpy(&r->opts, d, d->struct_size == sizeof *d ? sizeof *d
+                        : d->struct_size < end_0_5  ? d->struct_size
+                                                    : end_0_5);
     r->opts.struct_size = sizeof r->opts;
     if (d->struct_size == size_0_4)
         r->opts.preintegrated = preintegrated;
+    if (d->struct_size != sizeof *d) {
+        r->opts.mode = mode;
+        r->opts.interaction = interaction;
+    }
     return UMBRA_SUCCESS;
 }
 
@@ -368,7 +394,7 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
         release_kernels(r);
         r->tech = t;
     }
-    r->shadow = d;
+    r->shadow = r->shadow_set = d;
     if (preintegrated >= 0)
         r->opts.preintegrated = preintegrated;
     return UMBRA_SUCCESS;
@@ -425,11 +451,43 @@ static umbra_status check_ray_samples(umbra_renderer r, float step_voxels, const
     return UMBRA_SUCCESS;
 }
 
-/* Light tables and the shadow structure, rebuilt only when the light key changed. */
-static umbra_status prepare_shadow(umbra_renderer r, double build_share)
+/* The shadow description of this frame (frame) or query (!frame) into r->shadow: the
+ * application's, or under UMBRA_INTERACTION_AUTO its technique's draft where the full
+ * structure's inputs changed since the last frame (renderer.h). Returns whether it is a draft;
+ * *key receives the full structure's inputs, or the draft's. */
+static int choose_shadow(umbra_renderer r, int frame, umbra__light_key *key)
+{
+    const umbra__technique *t = r->tech;
+    umbra__light_key full;
+    r->shadow = r->shadow_set;
+    umbra__light_key_fill(r, t, &r->shadow_set, &full);
+    *key = full;
+    if (!frame)
+        return 0;
+    const int changed = r->last_valid && memcmp(&full, &r->last_key, sizeof full) != 0;
+    r->last_key = full;
+    r->last_valid = 1;
+    umbra_shadow_desc draft;
+    /* umbra__draft_desc keeps every value it sets within its parameter's range. */
+    if (!changed || r->opts.interaction != UMBRA_INTERACTION_AUTO ||
+        !umbra__draft_desc(t, &r->shadow_set, &draft))
+        return 0;
+    umbra__light_key_fill(r, t, &draft, key);
+    if (memcmp(key, &full, sizeof full) == 0)
+        return 0; /* the draft changes nothing the structure depends on: it is the full one */
+    r->shadow = draft;
+    return 1;
+}
+
+/* Light tables and the shadow structure, rebuilt only when the light key changed. frame: a
+ * render (progressive shadows apply), not a query. */
+static umbra_status prepare_shadow(umbra_renderer r, double build_share, int frame)
 {
     umbra__frame_update_light(r);
     const umbra__technique *t = r->tech;
+    umbra__light_key key;
+    const int draft = choose_shadow(r, frame, &key);
+    r->stats.draft = draft;
     float light_step = t->light_step ? t->light_step(&r->shadow) : 0.0f;
     umbra_status st = UMBRA_SUCCESS;
     if (t->light_step &&
@@ -441,8 +499,6 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share)
         return st;
     /* Every frame: a parameter that does not rebuild may set the step (the reference's). */
     r->shadow_params.step = light_step * umbra__voxel_world(r);
-    umbra__light_key key;
-    umbra__light_key_fill(r, t, &key);
     r->stats.shadow_rebuilt = 0;
     r->stats.shadow_build_ms = 0.0;
     if (r->built_valid && memcmp(&key, &r->built, sizeof key) == 0)
@@ -564,7 +620,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
         return st;
     /* A shadow build, if one is needed, is the first half of the progress reported. */
-    st = prepare_shadow(r, 0.5);
+    st = prepare_shadow(r, 0.5, 1);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
@@ -700,7 +756,7 @@ static umbra_status query_shadow(umbra_renderer r, const float *points, size_t c
                            "%s: technique '%s' has no per-point shadow lookup", fn,
                            r->tech->info.name);
     umbra__progress_begin(r);
-    if ((st = prepare_shadow(r, 0.5)) != UMBRA_SUCCESS)
+    if ((st = prepare_shadow(r, 0.5, 0)) != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)

@@ -149,7 +149,9 @@ struct umbra_renderer_t {
     int camera_set;
     umbra_light light;
     umbra_render_desc opts;
-    umbra_shadow_desc shadow;
+    umbra_shadow_desc shadow;                /* the description the shadow structure in use was
+                                                built for: shadow_set, or its draft */
+    umbra_shadow_desc shadow_set;            /* what the application set (set_shadow) */
     const umbra__technique *tech;
     void *tech_state;                        /* owned by the technique */
 
@@ -169,6 +171,9 @@ struct umbra_renderer_t {
                                                 its id and its ranges' version */
     umbra__light_key built;                  /* inputs of the current shadow structure */
     int built_valid;
+    umbra__light_key last_key;               /* the full structure's inputs at the last frame
+                                                (progressive shadows: did they change?) */
+    int last_valid;
     cl_mem out_buf;
     size_t out_bytes;
     cl_program program;                      /* the ray caster + technique program in use */
@@ -434,8 +439,15 @@ umbra_status umbra__validate_shadow(umbra_renderer r, const umbra__technique *t,
                                     const umbra_shadow_desc *d, const char *fn);
 
 /* Fills key with what technique t's structure depends on (info.rebuilt_by and its parameters
- * flagged UMBRA_PARAM_REBUILDS). */
-void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t, umbra__light_key *key);
+ * flagged UMBRA_PARAM_REBUILDS, as desc sets them). */
+void umbra__light_key_fill(umbra_renderer r, const umbra__technique *t,
+                           const umbra_shadow_desc *desc, umbra__light_key *key);
+
+/* Technique t's draft of desc (t->info.draft applied, umbra/registry.h) into *out; returns 0,
+ * with *out = *desc, where t has no draft or its draft string does not apply (the registry's
+ * tests check every technique's). */
+int umbra__draft_desc(const umbra__technique *t, const umbra_shadow_desc *desc,
+                      umbra_shadow_desc *out);
 
 /* Converts a desc of an older layout (struct_size tells which) into *out, or refuses it naming
  * fn; *preintegrated is set to the 0.4 layout's preintegrated (-1 for a newer layout, which has

@@ -91,10 +91,12 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
     const VolGeom g = vol_geom(F);
     const uint flags = F->flags;
     /* Frame constants the sample loop uses, read from the global frame once. */
-    const uint tf_size = F->tf_size;
+    const TfMap tm = tf_map(g, F->tf_size);
     const float termination = F->termination;
     float3 o, d;
     camera_ray(F, px, py, &o, &d);
+    /* The ray in voxel coordinates, where the volume is sampled: x = xo + t xd. */
+    const float3 xo = world_to_voxel(g, o), xd = d * g.inv_spacing;
 
     /* The ground plane n.x + w = 0 ends the ray where it is hit from above. */
     float t_ground = UMBRA_INF;
@@ -243,7 +245,11 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                     c = preint_lookup(preint, preint_size, sf, s_back);
                     c.xyz = preint_color(c);
                 } else {
-                    c = view_sample(F, vol, g, view_tf, tf_size, p);
+#if UMBRA_LABELS || UMBRA_CHANNELS > 1
+                    c = view_sample(F, vol, g, view_tf, F->tf_size, p);
+#else
+                    c = tf_classify(view_tf, tm, sample_stored(vol, g, xo + t * xd));
+#endif
                 }
             }
             if (pending) {

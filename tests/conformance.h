@@ -170,6 +170,25 @@ static inline float conf_ramp_ball(float x, float y, float z)
     return fminf(1.0f, fmaxf(0.0f, 0.5f - 0.25f * (sqrtf(x * x + y * y + z * z) - 9.0f)));
 }
 
+/* Two soft balls of different density (0.6 and 0.9) over a thin slab (0.35) in a 40 x 32 x 36
+ * grid: partial shadows in colour (the rebuild and progressive-shadow cases). */
+enum { CONF_TWO_BALLS_NX = 40, CONF_TWO_BALLS_NY = 32, CONF_TWO_BALLS_NZ = 36 };
+
+static inline float conf_two_balls(float x, float y, float z)
+{
+    x += 0.5f * CONF_TWO_BALLS_NX, y += 0.5f * CONF_TWO_BALLS_NY; /* from the corner */
+    z += 0.5f * CONF_TWO_BALLS_NZ;
+    float d1 = sqrtf((x - 14.0f) * (x - 14.0f) + (y - 20.0f) * (y - 20.0f) +
+                     (z - 15.0f) * (z - 15.0f)) - 7.0f;
+    float d2 = sqrtf((x - 27.0f) * (x - 27.0f) + (y - 17.0f) * (y - 17.0f) +
+                     (z - 22.0f) * (z - 22.0f)) - 5.0f;
+    float v = fmaxf(0.6f * fminf(1.0f, fmaxf(0.0f, 0.5f - d1)),
+                    0.9f * fminf(1.0f, fmaxf(0.0f, 0.5f - d2)));
+    if (y > 5.0f && y < 7.0f)
+        v = fmaxf(v, 0.35f);
+    return v;
+}
+
 /* A two-point transfer function: (r, g, b, a) at 0 and 1. */
 static inline umbra_status conf_tf(umbra_context ctx, const float lo[4], const float hi[4],
                                    umbra_transfer_function *out)

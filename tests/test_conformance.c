@@ -128,22 +128,8 @@ static void test_conformance_cases_within_bounds(void **state)
 
 /* ---- rebuild equals fresh -------------------------------------------------------------------- */
 
-enum { RB_NX = 40, RB_NY = 32, RB_NZ = 36, RB_W = 48, RB_H = 40 };
-
-/* Two soft balls of different density and a thin slab under them: partial shadows in colour. */
-static float rebuild_value(float x, float y, float z)
-{
-    x += 0.5f * RB_NX, y += 0.5f * RB_NY, z += 0.5f * RB_NZ; /* from the corner */
-    float d1 = sqrtf((x - 14.0f) * (x - 14.0f) + (y - 20.0f) * (y - 20.0f) +
-                     (z - 15.0f) * (z - 15.0f)) - 7.0f;
-    float d2 = sqrtf((x - 27.0f) * (x - 27.0f) + (y - 17.0f) * (y - 17.0f) +
-                     (z - 22.0f) * (z - 22.0f)) - 5.0f;
-    float v = fmaxf(0.6f * fminf(1.0f, fmaxf(0.0f, 0.5f - d1)),
-                    0.9f * fminf(1.0f, fmaxf(0.0f, 0.5f - d2)));
-    if (y > 5.0f && y < 7.0f)
-        v = fmaxf(v, 0.35f);
-    return v;
-}
+enum { RB_NX = CONF_TWO_BALLS_NX, RB_NY = CONF_TWO_BALLS_NY, RB_NZ = CONF_TWO_BALLS_NZ };
+enum { RB_W = 48, RB_H = 40 };
 
 static umbra_renderer rebuild_renderer(umbra_volume v, umbra_transfer_function tf,
                                        const umbra_light *light, const conf_row *row)
@@ -204,7 +190,7 @@ static void test_conformance_rebuild_equals_fresh(void **state)
     (void)state;
     umbra_volume vol;
     umbra_transfer_function tf_a, tf_b;
-    assert_int_equal(conf_volume(ctx, RB_NX, RB_NY, RB_NZ, rebuild_value, &vol), UMBRA_SUCCESS);
+    assert_int_equal(conf_volume(ctx, RB_NX, RB_NY, RB_NZ, conf_two_balls, &vol), UMBRA_SUCCESS);
     const float a[16] = {0, 0, 0, 0, 0.9f, 0.5f, 0.2f, 0.08f, 0.3f, 0.8f, 0.4f, 0.2f,
                          0.7f, 0.7f, 0.9f, 0.5f};
     const float b[16] = {0, 0, 0, 0, 0.9f, 0.5f, 0.2f, 0.15f, 0.3f, 0.8f, 0.4f, 0.4f,

@@ -577,6 +577,7 @@ const umbra__technique umbra__technique_deep = {
          * halve the error of one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
         .map_texels_per_voxel = 2.0f,
         .map_step = 0.5f, /* lightspace.h: its nodes follow the sampled visibility */
+        .draft = "map_texels_per_voxel<=1",
     },
     .params = params,
     .sweep = sweep,

@@ -104,6 +104,9 @@ const umbra__technique umbra__technique_threshold = {
          * sample the same voxels again). */
         .map_texels_per_voxel = 1.0f,
         .map_step = 1.0f, /* lightspace.h: the step only sets where the volume is sampled */
+        /* No draft: at one texel per voxel its full map rebuilds within issue #28's 2.5x of an
+         * unshadowed frame while the light moves (README, "Interactive sessions"). */
+        .draft = NULL,
     },
     .params = params,
     .sweep = sweep,

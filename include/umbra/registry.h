@@ -105,6 +105,15 @@ typedef struct umbra_technique_info {
     uint32_t param_count;   /* umbra_technique_param_get(t, 0 .. param_count - 1) */
     float map_texels_per_voxel; /* UMBRA_TECHNIQUE_MAP: what map.texels_per_voxel 0 means */
     float map_step;             /* UMBRA_TECHNIQUE_MAP: what map.step 0 means, in voxels */
+    /* What a draft frame changes (umbra_render_desc.interaction, umbra/renderer.h), as
+     * "key<=value;key>=value;key=value" over the parameters the application set: `<=` takes the
+     * smaller of the two (a zero that means "the technique's own" counts as that value, and one
+     * that means "unbounded" as infinite), `>=` the larger, `=` the value. A draft never asks
+     * for finer settings than the full structure's. Where the map's size is fixed (map_size
+     * N), a draft's map_texels_per_voxel K makes it N K / map_texels_per_voxel (rounded up to
+     * UMBRA_MAP_SIZE_AUTO_ROUND, at least UMBRA_MAP_SIZE_AUTO_MIN, at most N). NULL: the
+     * technique has no draft (it rebuilds at full quality, or has nothing to rebuild). */
+    const char *draft;
 } umbra_technique_info;
 
 /* The number of techniques in this build, and the index-th of them in the registry's order

@@ -94,6 +94,24 @@ typedef enum umbra_transmission {
  * is too anisotropic or too large for the step (raise the step, or resample the volume). */
 #define UMBRA_MAX_RAY_SAMPLES 1048576u
 
+/* Progressive shadows (umbra_render_desc.interaction). With UMBRA_INTERACTION_AUTO a frame whose
+ * shadow structure would be rebuilt because its inputs changed since the previous frame (the
+ * light, the volume, the light transfer function or the view one it uses, the transmission mode,
+ * empty-space skipping, the technique or one of its parameters that rebuild: every input of
+ * umbra_technique_info.rebuilt_by and UMBRA_PARAM_REBUILDS) builds the technique's draft instead
+ * (umbra_technique_info.draft: a coarser map, a larger error bound), and the next frame whose
+ * inputs are those of the frame before it builds the full structure, which equals what a fresh
+ * renderer builds bit for bit; a camera move changes none of these inputs, so it keeps the full
+ * structure (cached). umbra_render_stats.draft says which one the last frame used: an
+ * application that renders only on input events renders once more after the input stops while
+ * it is set. The first frame a renderer renders, shadow queries (umbra_renderer_query_shadow)
+ * and techniques without a draft always use the full structure. UMBRA_INTERACTION_OFF (the
+ * default): every frame uses the full structure. */
+typedef enum umbra_interaction {
+    UMBRA_INTERACTION_OFF = 0,
+    UMBRA_INTERACTION_AUTO = 1
+} umbra_interaction;
+
 /* How a frame turns samples into pixels (umbra_render_desc.mode). The projection modes take
  * the volume's normalised value at the view ray's samples (the composite mode's positions:
  * every step inside the volume's box and the clip region, jittered when jitter is set, no
@@ -143,9 +161,12 @@ typedef struct umbra_render_desc {
                                 segments of length `step`, and the convolution technique
                                 attenuates the light with the segment's pre-integrated
                                 transmittance (default 0) */
-    /* Added after umbra 0.5: a desc of that layout's size (offsetof(umbra_render_desc, mode))
-     * is accepted and leaves the mode as it was. */
+    /* Added after umbra 0.5: a desc of that layout's size (RENDER_DESC_SIZE_0_5 in
+     * host/renderer.c, or offsetof(umbra_render_desc, mode) without its padding) is accepted and
+     * leaves the fields below as they were. */
     umbra_render_mode mode;  /* default UMBRA_RENDER_COMPOSITE */
+    umbra_interaction interaction; /* UMBRA_INTERACTION_OFF (default) or _AUTO: progressive
+                                      shadows, above */
 } umbra_render_desc;
 
 /* Fills desc with the defaults given beside each field (struct_size included); NULL is a no-op. */
@@ -370,6 +391,10 @@ typedef struct umbra_render_stats {
     uint32_t map_size;           /* light-space techniques: texels per side of the map in use
                                     (the size UMBRA_MAP_SIZE_AUTO chose, or the one given);
                                     0 for the others. Fields are only ever appended here */
+    int draft;                   /* nonzero if the last frame used its technique's draft
+                                    (umbra_render_desc.interaction AUTO, the shadow inputs
+                                    changed since the frame before): rendering again with
+                                    nothing changed builds the full structure */
 } umbra_render_stats;
 
 /* Copies the last render's figures into *out. UMBRA_ERROR_INVALID_ARGUMENT for NULL r or out. */

@@ -87,6 +87,13 @@ UMBRA_INLINE float voxel_normalise(VolGeom g, float s)
 __constant sampler_t umbra_linear =
     CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_CLAMP_TO_EDGE | CLK_FILTER_LINEAR;
 
+/* The filtered stored value at voxel coordinates x (world_to_voxel), before voxel_normalise. */
+inline float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
+{
+    float3 u = (x + 0.5f) / convert_float3(g.dims);
+    return read_imagef(vol, umbra_linear, (float4)(u, 0.0f)).x;
+}
+
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 {
     float3 u = (p - g.box_min) / (g.box_max - g.box_min);
@@ -100,11 +107,12 @@ __constant sampler_t umbra_linear =
 /* Images cannot be held in variables or chosen with ?: in OpenCL C 1.2: one read per case. */
 #define UMBRA_SLAB_READ(i)                                                                     \
     case i:                                                                                    \
-        return voxel_normalise(g, read_imagef(vol_##i, umbra_linear, c).x);
+        return read_imagef(vol_##i, umbra_linear, c).x;
 
-inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+/* The filtered stored value at voxel coordinates x (world_to_voxel), before voxel_normalise. */
+inline float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
 {
-    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    x = clamp(x, (float3)(0.0f), convert_float3(g.dims - 1));
     int s = min((int)x.z / UMBRA_SLAB_STEP, UMBRA_VOLUME_SLABS - 1);
     float4 c = (float4)(x.x + 0.5f, x.y + 0.5f, x.z - (float)(s * UMBRA_SLAB_STEP) + 0.5f, 0.0f);
     switch (s) {
@@ -130,6 +138,11 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
 #endif
     }
     return 0.0f;
+}
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    return voxel_normalise(g, sample_stored(vol, g, world_to_voxel(g, p)));
 }
 #endif
 #else
@@ -195,9 +208,11 @@ UMBRA_INLINE __global const UMBRA_VOXEL_T *volume_slab(VOLUME_PARAM, int s)
 }
 #endif
 
-inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+/* The trilinear blend at voxel coordinates x (world_to_voxel) of voxel_load values: normalised
+ * where the range clamps voxels, else stored values (voxel_blended maps them). */
+UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
 {
-    float3 x = clamp(world_to_voxel(g, p), (float3)(0.0f), convert_float3(g.dims - 1));
+    x = clamp(x, (float3)(0.0f), convert_float3(g.dims - 1));
     /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
      * negative and huge values), a conversion one. */
     int3 i0 = convert_int3(x);
@@ -219,7 +234,12 @@ inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
     float2 c2 = voxel_load2(v, g, z1 + y0 + i0.x), c3 = voxel_load2(v, g, z1 + y1 + i0.x);
     float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
     float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
-    return voxel_blended(g, mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z));
+    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+}
+
+inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
+{
+    return voxel_blended(g, sample_stored(vol, g, world_to_voxel(g, p)));
 }
 #endif
 
@@ -262,6 +282,39 @@ UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
     }
 }
 #endif
+
+/* The view ray's classification in one step (issue #28): sample_stored's value s maps to a
+ * transfer function table's coordinate by one multiply-add, s * a + b (TfMap), clamped once to
+ * the table, instead of voxel_normalise's map and clamp followed by tf_lookup's clamp and scale.
+ * The same line as tf_lookup(sample_volume(..)) where nothing clamps, up to float rounding. */
+typedef struct TfMap {
+    float a, b, top; /* table coordinate s * a + b, clamped to [0, top = n - 1] */
+    int last;        /* n - 2: the last interval's first entry */
+} TfMap;
+
+inline TfMap tf_map(VolGeom g, uint n)
+{
+    TfMap m;
+    m.top = (float)(n - 1);
+    m.last = (int)n - 2;
+#if !UMBRA_SAMPLER_IMAGE && UMBRA_VOXEL_CLAMPS
+    m.a = m.top; /* sample_stored is normalised already */
+    m.b = 0.0f;
+#else
+    m.a = g.image_scale * g.value_scale * m.top;
+    m.b = -g.value_lo * g.value_scale * m.top;
+#endif
+    return m;
+}
+
+/* tf's entry at sample_stored value s, linearly interpolated (tf_lookup's arithmetic). */
+UMBRA_INLINE float4 tf_classify(__global const float4 *tf, TfMap m, float s)
+{
+    float x = clamp(fma(s, m.a, m.b), 0.0f, m.top);
+    int i = min((int)x, m.last);
+    float f = x - (float)i;
+    return mix(tf[i], tf[i + 1], f);
+}
 
 #if UMBRA_SAMPLER_IMAGE || UMBRA_VOLUME_SLABS > 1
 /* Central-difference gradient, one voxel each way, in value per world unit: six samples (on the

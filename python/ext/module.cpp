@@ -50,6 +50,13 @@ NB_MODULE(_umbra, m)
         .value("COLORED", UMBRA_TRANSMISSION_COLORED,
                "transmission colour from the light TF's RGB");
 
+    nb::enum_<umbra_interaction>(m, "Interaction",
+                                 "umbra_interaction: progressive shadows (RenderOptions."
+                                 "interaction)")
+        .value("OFF", UMBRA_INTERACTION_OFF, "every frame uses the full shadow structure")
+        .value("AUTO", UMBRA_INTERACTION_AUTO,
+               "a frame after a light or transfer-function change uses the technique's draft, "
+               "the next frame with nothing changed the full structure");
     nb::enum_<umbra_render_mode>(m, "RenderMode", "umbra_render_mode: how a view ray combines "
                                                   "its samples")
         .value("COMPOSITE", UMBRA_RENDER_COMPOSITE,

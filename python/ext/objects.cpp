@@ -411,7 +411,11 @@ void bind_objects(nb::module_ &m)
         .def_ro("samples", &umbra_render_stats::samples)
         .def_ro("map_size", &umbra_render_stats::map_size,
                 "light-space techniques: texels per side of the map in use (the size auto "
-                "chose), else 0");
+                "chose), else 0")
+        .def_prop_ro(
+            "draft", [](const umbra_render_stats &s) { return s.draft != 0; },
+            "the last frame used its technique's draft (RenderOptions.interaction 'auto'): "
+            "render again with nothing changed for the full structure");
 
     /* ---- Renderer ---- */
     static const std::string set_shadow_doc =

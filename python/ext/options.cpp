@@ -262,6 +262,10 @@ void bind_options(nb::module_ &m)
                "grey shadows, or coloured from the light transfer function's RGB");
     flag(ro, "preintegrated", &umbra_render_desc::preintegrated,
          "pre-integrated segments: the view ray's, and the convolution technique's light");
+    enum_field(ro, "interaction", &umbra_render_desc::interaction, "Interaction",
+               "progressive shadows: 'auto' renders the technique's draft in a frame after a light "
+               "or transfer-function change and the full structure once nothing changes "
+               "(RenderStats.draft says which); 'off' (default) always the full one");
     enum_field(ro, "mode", &umbra_render_desc::mode, "RenderMode",
                "composite (lit, shadowed), or a projection: mip, minip, average (technique "
                "none only; docs/features.md)");

@@ -119,6 +119,29 @@ def test_map_size_auto_is_the_default_and_reported(ctx, spheres):
         assert r.stats.map_size == 0
 
 
+def test_interaction_auto_drafts_while_the_light_moves(ctx, spheres):
+    assert umbra.RenderOptions().interaction == umbra.Interaction.OFF
+    moved = umbra.Light.directional((-0.3, -1.0, -0.5))
+    with spheres.renderer() as r:
+        r.set_options(spheres.options, interaction="auto")
+        assert r.options.interaction == umbra.Interaction.AUTO
+        r.set_shadow(technique="deep")
+        r.render(32, 24)
+        assert not r.stats.draft  # the first frame: nothing moved before it
+        full = r.stats.map_size
+        r.light = moved
+        r.render(32, 24)
+        assert r.stats.draft and r.stats.shadow_rebuilt and r.stats.map_size < full
+        refined = r.render(32, 24)  # nothing changed: the full map
+        assert not r.stats.draft and r.stats.shadow_rebuilt
+    with spheres.renderer() as f:
+        f.light = moved
+        f.set_shadow(technique="deep")
+        assert np.array_equal(refined, f.render(32, 24))
+    with pytest.raises(TypeError):
+        umbra.RenderOptions(interaction="sometimes")
+
+
 def test_render_into_callers_array(ctx, spheres):
     out = np.full((H, W, 4), -1.0, np.float32)
     with spheres.renderer() as r:

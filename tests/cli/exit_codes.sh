@@ -52,6 +52,10 @@ expect 1 "UMBRA_ERROR_INVALID_ARGUMENT" -- "${small[@]}" --technique deep --map-
 expect 1 "cssm ray_block 4 must be 0" -- "${small[@]}" --technique cssm --ray-block 4 \
     --out "$tmp/a.png"
 expect 0 "wrote" -- "${small[@]}" --technique cssm --ray-block 1 --out "$tmp/a.png"
+# --interaction: off or auto (a single frame is the full map either way: nothing moved before it).
+expect 0 "wrote" -- "${small[@]}" --technique deep --interaction auto --out "$tmp/a.png"
+expect 1 "--interaction 'on' is neither off nor auto" --no-render -- "${small[@]}" \
+    --interaction on --out "$tmp/a.png"
 # Row 10: out of memory is a failure (2) wherever it happens, also while loading the volume. A
 # sparse 4 GiB file (no disk used) under a 3 GB address-space limit makes the voxel buffer fail.
 # Not under AddressSanitizer (.ci/sanitize.sh), whose shadow memory cannot live under ulimit -v.

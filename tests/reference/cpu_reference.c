@@ -43,12 +43,19 @@ typedef struct prep {
     v3 light_vec;                 /* point position or unit travel direction */
 } prep;
 
-static float sample(const prep *P, v3 p)
+/* Voxel coordinates of world point p: voxel centres at whole numbers. */
+static v3 to_voxel(const prep *P, v3 p)
+{
+    return mk((p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
+              (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
+              (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f);
+}
+
+/* The clamped trilinear sample at voxel coordinates xv. */
+static float sample_voxel(const prep *P, v3 xv)
 {
     const cpu_scene *s = P->s;
-    float x[3] = {(p.x - P->bmin.x) * P->inv_spacing.x - 0.5f,
-                  (p.y - P->bmin.y) * P->inv_spacing.y - 0.5f,
-                  (p.z - P->bmin.z) * P->inv_spacing.z - 0.5f};
+    float x[3] = {xv.x, xv.y, xv.z};
     int i0[3], i1[3];
     float f[3];
     for (int a = 0; a < 3; ++a) {
@@ -67,6 +74,8 @@ static float sample(const prep *P, v3 p)
 #undef V
     return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
 }
+
+static float sample(const prep *P, v3 p) { return sample_voxel(P, to_voxel(P, p)); }
 
 static void lookup(const float *tf, int n, float v, float out[4])
 {
@@ -910,6 +919,9 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
             const float hstep = P->step;
             float jitter = o->jitter ? random01(o->seed, (uint32_t)px, (uint32_t)py, 0u) : 0.0f;
             int n = (int)ceilf((t1 - t0) / hstep - jitter);
+            /* The view ray in voxel coordinates, where its samples are taken (the kernel's xo,
+             * xd): x = xo + t xd. */
+            const v3 xo = to_voxel(P, org), xd = vmul(d, P->inv_spacing);
             walk w;
             walk_begin(P, &w, org, d, t0);
             float t_cell = -INFINITY; /* samples before it lie in a visible cell */
@@ -958,7 +970,7 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 }
                 v3 p = add(org, mul(d, t));
                 ++taken;
-                lookup(P->view_tf, P->view_n, sample(P, p), c);
+                lookup(P->view_tf, P->view_n, sample_voxel(P, add(xo, mul(xd, t))), c);
                 if (c[3] > 0.0f) {
                     /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
                      * a segment of opacity a (kernels/raycast.cl, shadow_point). */

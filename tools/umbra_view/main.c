@@ -259,10 +259,11 @@ static void print_view(const viewer *v, FILE *f)
     fprintf(f, " --light-%s %.9g,%.9g,%.9g --light-color %.9g,%.9g,%.9g",
             l->type == UMBRA_LIGHT_POINT ? "pos" : "dir", p[0], p[1], p[2], l->color[0],
             l->color[1], l->color[2]);
-    fprintf(f, " --step %.9g %s %s %s%s", o->step, o->shading ? "--shading" : "--no-shading",
-            o->ground_plane ? "--ground" : "--no-ground",
+    fprintf(f, " --step %.9g %s %s %s%s --interaction %s", o->step,
+            o->shading ? "--shading" : "--no-shading", o->ground_plane ? "--ground" : "--no-ground",
             o->transmission == UMBRA_TRANSMISSION_COLORED ? "--colored" : "--grey",
-            o->preintegrated ? " --preintegrated" : "");
+            o->preintegrated ? " --preintegrated" : "",
+            o->interaction == UMBRA_INTERACTION_AUTO ? "auto" : "off");
     static const char *const modes[] = {"composite", "mip", "minip", "average"};
     if (o->mode != UMBRA_RENDER_COMPOSITE && (unsigned)o->mode < 4)
         fprintf(f, " --mode %s", modes[o->mode]);
@@ -288,13 +289,12 @@ static void print_view(const viewer *v, FILE *f)
     fflush(f);
 }
 
-/* Whether the frame's shadows were a draft. umbra_render_stats does not say yet (the library
- * builds the full structure for every frame), so every frame is full; when the stats carry it
- * (progressive shadows, issue #28), this reads it and the loop refines when idle. */
+/* Whether the frame's shadows were a draft (interaction auto: the frame after a light, light
+ * transfer function or shadow-parameter change); the loop renders once more when idle, and the
+ * library builds the full structure for that frame. */
 static int stats_draft(const umbra_render_stats *st)
 {
-    (void)st;
-    return 0;
+    return st->draft != 0;
 }
 
 /* The progress callback: keeps the window answering during a long render, shows the fraction in
@@ -591,7 +591,10 @@ static int run(viewer *v, const view_options *o)
                 printf("frame %u/%u: %.1f ms (umbra %.1f ms: shadow build %.1f ms %s, render "
                        "%.1f ms; upload %.1f ms; draw %.1f ms)\n",
                        frame, replay, v->times.frame_ms, v->times.umbra_ms,
-                       v->stats.shadow_build_ms, v->stats.shadow_rebuilt ? "rebuilt" : "reused",
+                       v->stats.shadow_build_ms,
+                       !v->stats.shadow_rebuilt ? "reused"
+                       : v->stats.draft         ? "rebuilt, draft"
+                                                : "rebuilt",
                        v->stats.render_ms, v->times.upload_ms, v->times.draw_ms);
                 double *row = ms + 4 * (size_t)(frame - 1);
                 row[0] = v->times.frame_ms;
@@ -638,14 +641,18 @@ int main(int argc, char **argv)
     const program prog = {
         "umbra-view",
         "interactive; every umbra-render option applies: --size WxH is the window's size, --out "
-        "FILE is where S writes the frame. Mouse: left orbit, middle or shift+left pan, wheel "
-        "zoom, right or ctrl+left light. Keys: S save frame, G/Tab panel, P print view options, "
-        "R reset view, Esc quit.",
+        "FILE is where S writes the frame; --interaction is auto unless given. Mouse: left "
+        "orbit, middle or shift+left pan, wheel zoom, right or ctrl+left light. Keys: S save "
+        "frame, G/Tab panel, P print view options, R reset view, Esc quit.",
         view_option_list, sizeof view_option_list / sizeof view_option_list[0], view_take, &o};
     options args;
     int rc = parse_args_as(&prog, argc, argv, &args);
     if (rc)
         return rc;
+    /* A viewer is where the light is dragged: drafts while it moves, the full map when it
+     * stops, unless the command line says otherwise. */
+    if (!args.have_interaction)
+        args.interaction = UMBRA_INTERACTION_AUTO;
     viewer v;
     memset(&v, 0, sizeof v);
     v.preset = -1;

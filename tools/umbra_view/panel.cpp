@@ -276,6 +276,14 @@ void section_render(viewer *v)
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip("pre-integrated segments along the view ray (and the convolution "
                           "technique's light)");
+    bool progressive = o->interaction == UMBRA_INTERACTION_AUTO;
+    if (ImGui::Checkbox("progressive shadows", &progressive)) {
+        o->interaction = progressive ? UMBRA_INTERACTION_AUTO : UMBRA_INTERACTION_OFF;
+        v->changed |= VIEW_CHANGED_OPTIONS;
+    }
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("interaction auto: the technique's draft while the light or a shadow "
+                          "setting changes, the full structure once it stops");
     if (ImGui::SliderFloat("step", &o->step, 0.05f, 4.0f, "%.3g voxels",
                            ImGuiSliderFlags_Logarithmic))
         v->changed |= VIEW_CHANGED_OPTIONS;
