@@ -194,7 +194,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                                       sample_volume(vol, g, p + (frac * h) * d));
                     c.xyz = preint_color(c);
                 } else {
-                    c = view_sample(F, vol, g, view_tf, tf_size, p);
+                    c = view_sample(F, vol, g, view_tf, F->tf_size, p);
                 }
                 const float a = pre ? alpha_for_length(c.w, jitter) : c.w;
                 if (!(a > 0.0f))
