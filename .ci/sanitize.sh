@@ -39,7 +39,14 @@ t1=$SECONDS
 ASAN_OPTIONS=detect_leaks=1:use_sigaltstack=0:abort_on_error=0 \
 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan --output-on-failure -j"$jobs" -E '^test_(packaging|python)$'
+    ctest --test-dir build-asan --output-on-failure -j"$jobs" -E '^(test_(packaging|python)|viewer_.*)$'
+# umbra-view under ASan + UBSan without the leak check: its GL driver (Mesa, through GLFW) and the
+# kernel modules PoCL loads are unloaded before the process exits, so a leak of theirs is reported
+# from "<unknown module>", which no suppression can name (seen in one of four runs, 2026-12-02).
+# The library's own leaks are checked by every other test above.
+ASAN_OPTIONS=detect_leaks=0:use_sigaltstack=0:abort_on_error=0 \
+UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan --output-on-failure -R '^viewer_'
 t2=$SECONDS
 
 # ---- TSan: threads creating contexts at start-up, and renderers sharing a context --------------
