@@ -5,8 +5,8 @@
 - every relative link and image in README.md, docs/*.md, bench/README.md and bench/results/**/*.md
   resolves to a file in the tree, and a `#fragment` to a heading of its target (GitHub's anchors);
 - README.md stays a guide: at most MAX_README_LINES lines;
-- no text there names the project's own work history other than by commit or date ("stop 24",
-  "this stop", "an earlier session"...);
+- no text there names the project's own work history other than by commit or date (a numbered
+  round of work, "this session", and the like: the patterns below);
 - with UMBRA_BENCH, `umbra-bench readme --check` passes: the generated blocks are current.
 Prints each problem as FILE:LINE: message and exits 1 if there is any."""
 import pathlib
