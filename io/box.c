@@ -228,12 +228,17 @@ umbra_status umbra_volume_read_box(umbra_context ctx, const char *path,
         st = umbra__box_load_raw(ctx, path, desc->raw, &box);
     } else if (ends_with_nocase(path, ".nrrd") || ends_with_nocase(path, ".nhdr")) {
         st = umbra__volume_load_nrrd(ctx, path, desc->options, &box, NULL);
+    } else if (ends_with_nocase(path, ".mha") || ends_with_nocase(path, ".mhd")) {
+        st = umbra__volume_load_metaimage(ctx, path, desc->options, &box, NULL);
+    } else if (ends_with_nocase(path, ".nii") || ends_with_nocase(path, ".nii.gz")) {
+        st = umbra__nifti_read_box(ctx, path, &box);
     } else if (ends_with_nocase(path, ".dat")) {
         st = umbra__volume_load_dat(ctx, path, desc->options, &box, NULL);
     } else {
         st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                         "%s: \"%s\": a box is read from NRRD (.nrrd, .nhdr), Voreen .dat and "
-                         "raw files (desc->raw); load other formats whole",
+                         "%s: \"%s\": a box is read from NRRD (.nrrd, .nhdr), NIfTI (.nii, "
+                         ".nii.gz), MetaImage (.mha, .mhd), Voreen .dat and raw files "
+                         "(desc->raw); load other formats whole",
                          __func__, path);
     }
     if (st != UMBRA_SUCCESS) {

@@ -245,7 +245,7 @@ umbra_status umbra_volume_load_with_options(umbra_context ctx, const char *path,
         return umbra__volume_load_nrrd(ctx, path, options, NULL, out);
     }
     if (ends_with_nocase(path, ".mha") || ends_with_nocase(path, ".mhd")) {
-        return umbra__volume_load_metaimage(ctx, path, options, out);
+        return umbra__volume_load_metaimage(ctx, path, options, NULL, out);
     }
     if (ends_with_nocase(path, ".dat")) {
         return umbra__volume_load_dat(ctx, path, options, NULL, out);

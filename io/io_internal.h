@@ -91,6 +91,9 @@ umbra_status umbra__box_info(umbra_context ctx, const char *func, const umbra__b
 umbra_status umbra__box_read(umbra_context ctx, const char *func, const char *name, FILE *f,
                              size_t compressed, size_t skip, const uint32_t dims[3],
                              size_t voxel_bytes, size_t swap_width, const umbra__box *box);
+/* umbra_volume_read_box on a NIfTI file (io/nifti.c: any type it loads, converted as it loads
+ * it; .nii.gz inflated as a stream). */
+umbra_status umbra__nifti_read_box(umbra_context ctx, const char *path, const umbra__box *box);
 /* umbra_volume_read_box on a headerless raw file. */
 umbra_status umbra__box_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
                                  const umbra__box *box);
@@ -103,7 +106,7 @@ umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
                                      const umbra__box *box, umbra_volume *out);
 umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
                                           const umbra_volume_load_options *options,
-                                          umbra_volume *out);
+                                          const umbra__box *box, umbra_volume *out);
 umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
                                     const umbra_volume_load_options *options,
                                     const umbra__box *box, umbra_volume *out);

@@ -5,7 +5,8 @@
  * Files hold v(x, y, z) = x + 7 y + 131 z (uint16, either byte order; float32 alike), so every
  * voxel of a box read back is checked against the formula at its global position: a box
  * shifted by one voxel or a row read from the wrong place shows. Raw files, detached NRRD (raw
- * and gzip, with a byte skip), attached gzip NRRD; the header alone; a box outside the grid and
+ * and gzip, with a byte skip), attached gzip NRRD, NIfTI (.nii as kept, .nii.gz as int32 converted
+ * to float32), MetaImage (.mha big-endian, .mhd with zlib data); the header alone; a box outside the grid and
  * an encoding that is not read by box are refused naming the values. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -18,8 +19,10 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <nifti2_io.h>
 #include <zlib.h>
 
+#include "nifti_test.h"
 #include "test_util.h"
 
 #define NX 37
@@ -152,6 +155,72 @@ static void test_nrrd_raw_and_gzip_boxes_match_formula(void **state)
     free(v);
 }
 
+static void test_nifti_boxes_match_formula(void **state)
+{
+    umbra_context ctx = *state;
+    char nii[1024], gz[1024];
+    int64_t dims[8] = {3, NX, NY, NZ, 1, 1, 1, 1};
+    umbra_volume_box_desc d;
+    umbra_volume_file_info info;
+    void *vox = NULL;
+    nifti_image *nim = nifti_make_new_nim(dims, DT_UINT16, 1);
+    assert_non_null(nim);
+    uint16_t *v = grid(0);
+    memcpy(nim->data, v, sizeof *v * NX * NY * NZ);
+    test_nifti_write(nim, test_tmp_path(nii, sizeof nii, "box.nii"));
+    check_box(ctx, nii, NULL, box_o, box_s);
+
+    /* int32 becomes float32, row by row, from a gzip stream. */
+    nim = nifti_make_new_nim(dims, DT_INT32, 1);
+    assert_non_null(nim);
+    for (size_t i = 0; i < (size_t)NX * NY * NZ; ++i)
+        ((int32_t *)nim->data)[i] = v[i];
+    test_nifti_write(nim, test_tmp_path(gz, sizeof gz, "box.nii.gz"));
+    umbra_volume_box_desc_init(&d);
+    memcpy(d.origin, box_o, sizeof d.origin);
+    memcpy(d.size, box_s, sizeof d.size);
+    assert_int_equal(umbra_volume_read_box(ctx, gz, &d, &info, &vox), UMBRA_SUCCESS);
+    assert_int_equal(info.type, UMBRA_FLOAT32);
+    for (uint32_t z = 0; z < box_s[2]; ++z)
+        for (uint32_t y = 0; y < box_s[1]; ++y)
+            for (uint32_t x = 0; x < box_s[0]; ++x)
+                assert_true(((float *)vox)[(z * box_s[1] + y) * box_s[0] + x] ==
+                            (float)value(box_o[0] + x, box_o[1] + y, box_o[2] + z));
+    free(vox);
+    free(v);
+}
+
+static void test_metaimage_boxes_match_formula(void **state)
+{
+    umbra_context ctx = *state;
+    char mha[1024], mhd[1024], zraw[1024];
+    uint16_t *v = grid(1);
+    const size_t bytes = sizeof *v * NX * NY * NZ;
+    const char *head = "ObjectType = Image\nNDims = 3\nDimSize = 37 20 11\n"
+                       "ElementType = MET_USHORT\nBinaryData = True\n"
+                       "BinaryDataByteOrderMSB = True\nElementDataFile = LOCAL\n";
+    FILE *f = fopen(test_tmp_path(mha, sizeof mha, "box.mha"), "wb");
+    assert_non_null(f);
+    fwrite(head, 1, strlen(head), f);
+    fwrite(v, 1, bytes, f);
+    fclose(f);
+    check_box(ctx, mha, NULL, box_o, box_s);
+
+    /* zlib-compressed data file (.zraw). */
+    uLongf packed_n = compressBound(bytes);
+    unsigned char *packed = malloc(packed_n);
+    assert_non_null(packed);
+    assert_int_equal(compress(packed, &packed_n, (const Bytef *)v, bytes), Z_OK);
+    test_write_bytes(test_tmp_path(zraw, sizeof zraw, "box.zraw"), packed, packed_n);
+    test_write_text(test_tmp_path(mhd, sizeof mhd, "box.mhd"),
+                    "ObjectType = Image\nNDims = 3\nDimSize = 37 20 11\n"
+                    "ElementType = MET_USHORT\nBinaryData = True\nBinaryDataByteOrderMSB = True\n"
+                    "CompressedData = True\nElementDataFile = box.zraw\n");
+    check_box(ctx, mhd, NULL, box_o, box_s);
+    free(packed);
+    free(v);
+}
+
 static void test_header_only_and_bad_boxes_refused(void **state)
 {
     umbra_context ctx = *state;
@@ -189,8 +258,8 @@ static void test_header_only_and_bad_boxes_refused(void **state)
     d.size[0] = 1;
     test_assert_failed(ctx, umbra_volume_read_box(ctx, hex, &d, &info, &vox),
                        UMBRA_ERROR_UNSUPPORTED, "raw or gzip", "hex");
-    test_assert_failed(ctx, umbra_volume_read_box(ctx, "x.nii", &d, &info, &vox),
-                       UMBRA_ERROR_UNSUPPORTED, "x.nii", NULL);
+    test_assert_failed(ctx, umbra_volume_read_box(ctx, "x.vti", &d, &info, &vox),
+                       UMBRA_ERROR_UNSUPPORTED, "x.vti", NULL);
     d.struct_size = 3;
     test_assert_failed(ctx, umbra_volume_read_box(ctx, hdr, &d, &info, &vox),
                        UMBRA_ERROR_INVALID_ARGUMENT, "struct_size", NULL);
@@ -202,6 +271,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_raw_box_matches_formula),
         cmocka_unit_test(test_nrrd_raw_and_gzip_boxes_match_formula),
+        cmocka_unit_test(test_nifti_boxes_match_formula),
+        cmocka_unit_test(test_metaimage_boxes_match_formula),
         cmocka_unit_test(test_header_only_and_bad_boxes_refused),
     };
     return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);

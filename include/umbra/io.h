@@ -198,8 +198,10 @@ typedef struct umbra_volume_box_desc {
 /* Fills desc with the defaults (struct_size included); NULL is a no-op. */
 UMBRA_API void umbra_volume_box_desc_init(umbra_volume_box_desc *desc);
 
-/* Reads the header of the volume file path (NRRD .nrrd / .nhdr with raw or gzip encoding, Voreen
- * .dat, or a raw file described by desc->raw) into *info and, when desc->size is not all 0, the
+/* Reads the header of the volume file path (NRRD .nrrd / .nhdr with raw or gzip encoding; NIfTI
+ * .nii / .nii.gz, converted as umbra_volume_load_nifti converts; MetaImage .mha / .mhd, raw or
+ * compressed, of the types kept as they are (MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT); Voreen
+ * .dat; or a raw file described by desc->raw) into *info and, when desc->size is not all 0, the
  * voxels of the box desc->origin + [0, desc->size) into a malloc'ed *voxels (x fastest, channels
  * interleaved, in info->type, the host's byte order; the caller frees it with free()). The file's
  * size is checked as umbra_volume_load does. A box outside the grid is UMBRA_ERROR_INVALID_ARGUMENT
