@@ -24,12 +24,12 @@ void umbra__frame_update_light(umbra_renderer r)
     umbra_volume v = r->volume;
     float ext[3];
     for (int a = 0; a < 3; ++a)
-        ext[a] = (float)v->dims[a] * v->spacing[a];
+        ext[a] = (float)v->grid_dims[a] * v->spacing[a];
     set4(F->box_min, -0.5f * ext[0], -0.5f * ext[1], -0.5f * ext[2], 0.0f);
     set4(F->box_max, 0.5f * ext[0], 0.5f * ext[1], 0.5f * ext[2], 0.0f);
     set4(F->inv_spacing, 1.0f / v->spacing[0], 1.0f / v->spacing[1], 1.0f / v->spacing[2], 0.0f);
     for (int a = 0; a < 3; ++a) {
-        F->dims[a] = (int32_t)v->dims[a];
+        F->dims[a] = (int32_t)v->grid_dims[a];
         F->bricks[a] = (int32_t)v->brick_counts[a];
     }
     F->dims[3] = 0;
@@ -105,7 +105,7 @@ void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     const umbra_render_desc *o = &r->opts;
     float ext[3], diag = 0.0f;
     for (int a = 0; a < 3; ++a) {
-        ext[a] = (float)r->volume->dims[a] * r->volume->spacing[a];
+        ext[a] = (float)r->volume->grid_dims[a] * r->volume->spacing[a];
         diag += ext[a] * ext[a];
     }
     diag = sqrtf(diag);

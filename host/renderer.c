@@ -420,7 +420,7 @@ double umbra__ray_samples(umbra_renderer r, float step_voxels)
 {
     double diag = 0.0;
     for (int a = 0; a < 3; ++a) {
-        double e = (double)r->volume->dims[a] * r->volume->spacing[a];
+        double e = (double)r->volume->grid_dims[a] * r->volume->spacing[a];
         diag += e * e;
     }
     return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
