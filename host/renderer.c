@@ -610,6 +610,10 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_context ctx = r->ctx;
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
+    if (st == UMBRA_SUCCESS && r->volume->is_part && !r->part_call)
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: the volume is a part of a global grid: render it with "
+                           "umbra_renderer_render_part (umbra/part.h)", fn);
     if (st == UMBRA_SUCCESS)
         st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
