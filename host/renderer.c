@@ -420,7 +420,7 @@ double umbra__ray_samples(umbra_renderer r, float step_voxels)
 {
     double diag = 0.0;
     for (int a = 0; a < 3; ++a) {
-        double e = (double)r->volume->dims[a] * r->volume->spacing[a];
+        double e = (double)r->volume->grid_dims[a] * r->volume->spacing[a];
         diag += e * e;
     }
     return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
@@ -610,6 +610,10 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_context ctx = r->ctx;
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
+    if (st == UMBRA_SUCCESS && r->volume->is_part && !r->part_call)
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: the volume is a part of a global grid: render it with "
+                           "umbra_renderer_render_part (umbra/part.h)", fn);
     if (st == UMBRA_SUCCESS)
         st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
