@@ -233,6 +233,7 @@ int session_setup(const options *o, session *s)
     if (o->have_light_color) memcpy(light.color, o->light_color, sizeof light.color);
     if (o->have_ambient) rd.ambient[0] = rd.ambient[1] = rd.ambient[2] = o->ambient;
     if (o->have_step) rd.step = o->step;
+    if (o->have_termination) rd.termination = o->termination;
     if (o->shading >= 0) rd.shading = o->shading;
     if (o->ground >= 0) rd.ground_plane = o->ground;
     if (o->colored >= 0) rd.transmission = o->colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;

@@ -27,6 +27,8 @@ typedef struct options {
     int have_camera_dir, have_eye, have_target, have_up;
     float light_dir[3], light_pos[3], light_color[3], ambient, step, background[4];
     int have_light_dir, have_light_pos, have_light_color, have_ambient, have_step;
+    float termination;                                              /* --termination */
+    int have_termination;
     float tf_range[2];
     int have_tf_range;
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
