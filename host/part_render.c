@@ -246,7 +246,8 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     const size_t px = 4 * sizeof(float);
-    const size_t origin[3] = {rect.x * px, rect.y, 0}, region[3] = {rect.width * px, rect.height, 1};
+    const size_t origin[3] = {rect.x * px, rect.y, 0};
+    const size_t region[3] = {rect.width * px, rect.height, 1};
     UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, (size_t[3]){0, 0, 0},
                                      region, width * px, 0, rect.width * px, 0, rgba, 0, NULL,
                                      NULL));

@@ -102,7 +102,8 @@ static scene make_scene(int ortho, int jitter, int shading, int point, int color
         s.camera.eye[2] = 2.0f * diag;
         s.camera.ortho_height = 1.1f * diag;
     }
-    s.light = point ? test_point_light(3.0f, 5.0f, -2.0f) : test_directional_light(0.3f, -1.0f, 0.4f);
+    s.light = point ? test_point_light(3.0f, 5.0f, -2.0f)
+                    : test_directional_light(0.3f, -1.0f, 0.4f);
     if (point == 2)
         s.light = test_point_light(80.0f, 60.0f, 90.0f);
     if (!point && ortho)
