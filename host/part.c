@@ -82,8 +82,9 @@ static umbra_status check_part(umbra_context ctx, const umbra_volume_desc *d,
                                (unsigned long long)(g - o - s), UMBRA_PART_MAX_GHOST);
         if (d->dims[a] != lo + s + hi)
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: desc->dims[%d] (%c) %u is not ghost_lo + size + ghost_hi = %llu",
-                               fn, a, AXIS[a], d->dims[a], (unsigned long long)(lo + s + hi));
+                               "%s: desc->dims[%d] (%c) %u is not ghost_lo + size + ghost_hi = "
+                               "%llu", fn, a, AXIS[a], d->dims[a],
+                               (unsigned long long)(lo + s + hi));
     }
     if (*empty && (d->dims[0] != 1 || d->dims[1] != 1 || d->dims[2] != 1))
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,

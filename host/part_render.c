@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lightspace.h"
 #include "renderer_internal.h"
+#include "techniques/maps.h"
 
 static const char *const AXIS = "xyz";
 
@@ -42,10 +44,9 @@ void umbra__part_frame(umbra_renderer r, int view)
             F->part_hi[a] = -INFINITY;
         }
     }
-    if (view) {
+    F->flags &= ~UMBRA_FLAG_SKIP_EMPTY;
+    if (view)
         memset(F->background, 0, sizeof F->background);
-        F->flags &= ~UMBRA_FLAG_SKIP_EMPTY;
-    }
 }
 
 /* The rectangle of the width x height image the core box's corners project to, grown by a pixel
@@ -137,11 +138,17 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
                            "%s: technique %s does not split into parts: its slices carry the light "
                            "over the whole view depth", fn, tech);
     case UMBRA_SHADOW_THRESHOLD:
+        if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: technique %s: import the depths of all parts "
+                               "(umbra_renderer_part_import_depths) after the last light build",
+                               fn, tech);
+        break;
     case UMBRA_SHADOW_CSSM:
     case UMBRA_SHADOW_DEEP:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is not part-aware yet: its light exchange is not "
-                           "implemented (only none renders on a part)", fn, tech);
+                           "implemented (none and threshold render on a part)", fn, tech);
     default:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is refused on a part: its light structure has no "
@@ -246,7 +253,8 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         return st;
     const size_t px = 4 * sizeof(float);
-    const size_t origin[3] = {rect.x * px, rect.y, 0}, region[3] = {rect.width * px, rect.height, 1};
+    const size_t origin[3] = {rect.x * px, rect.y, 0};
+    const size_t region[3] = {rect.width * px, rect.height, 1};
     UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, (size_t[3]){0, 0, 0},
                                      region, width * px, 0, rect.width * px, 0, rgba, 0, NULL,
                                      NULL));
@@ -267,13 +275,76 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
     return st;
 }
 
-/* The light exchange: no technique implements it yet; none needs nothing. */
+/* ---- the light exchange -------------------------------------------------------------------- */
+
+/* Floats per texel of the threshold march's state: the product P of whole segments' 1 - alpha
+ * and the optical depth tau (kernels/techniques/threshold.cl). */
+#define STATE_FLOATS 2u
+
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
-    const char *tech = r->volume ? umbra_shadow_technique_name(r->shadow_set.technique) : NULL;
+    const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
     return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
-                       "%s: technique %s has no light exchange between parts yet", fn,
-                       tech ? tech : "?");
+                       "%s: technique %s has no light exchange between parts (none and threshold "
+                       "have)", fn, tech ? tech : "?");
+}
+
+/* The light inputs brought up to date and the map size chosen, for a part whose technique
+ * exchanges light (threshold). */
+static umbra_status light_ready(umbra_renderer r, const char *fn, uint32_t *map_size)
+{
+    if (!r->volume || !r->volume->is_part || !r->tf)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: set a part volume (umbra_volume_create_part) and a transfer "
+                           "function first", fn);
+    if (r->shadow_set.technique != UMBRA_SHADOW_THRESHOLD)
+        return light_unsupported(r, fn);
+    umbra_status st = umbra__effective_tfs(r);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    umbra__frame_update_light(r);
+    r->shadow = r->shadow_set; /* what the build will use: parts refuse drafts */
+    umbra__lightspace_setup(r, r->shadow.map.size);
+    *map_size = r->shadow_params.map_size;
+    return UMBRA_SUCCESS;
+}
+
+umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index, uint32_t n)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const size_t floats = (size_t)n * n * STATE_FLOATS, bytes = floats * sizeof(float);
+    if (r->part_state_in && r->part_state_floats != floats)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra_renderer_render_part: the imported transmittance holds %zu "
+                           "floats, the %u x %u map %zu: import it again", r->part_state_floats, n,
+                           n, floats);
+    float *init = NULL;
+    const float *src = r->part_state_in;
+    if (!src) {
+        if (!(init = malloc(bytes)))
+            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
+                               "umbra_renderer_render_part");
+        for (size_t i = 0; i < floats; i += STATE_FLOATS) {
+            init[i] = 1.0f;
+            init[i + 1] = 0.0f;
+        }
+        src = init;
+    }
+    size_t have = 0;
+    if (r->part_state_buf)
+        UMBRA_CL(clGetMemObjectInfo(r->part_state_buf, CL_MEM_SIZE, sizeof have, &have, NULL));
+    if (have != bytes)
+        umbra__release_mem(&r->part_state_buf);
+    if ((st = umbra__ensure_buffer(r, &r->part_state_buf, bytes, CL_MEM_READ_WRITE)) !=
+        UMBRA_SUCCESS)
+        goto fail;
+    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0, bytes, src, 0, NULL,
+                                  NULL));
+    UMBRA_CL(clSetKernelArg(k, index, sizeof(cl_mem), &r->part_state_buf));
+fail:
+    free(init);
+    return st;
 }
 
 umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_info *out)
@@ -283,38 +354,127 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: out %p must be non-NULL with struct_size %zu", __func__,
                            (void *)out, sizeof *out);
-    if (r->shadow_set.technique != UMBRA_SHADOW_NONE)
-        return light_unsupported(r, __func__);
     memset(out, 0, sizeof *out);
     out->struct_size = sizeof *out;
-    out->kind = UMBRA_PART_LIGHT_NOTHING;
+    if (r->shadow_set.technique == UMBRA_SHADOW_NONE) {
+        out->kind = UMBRA_PART_LIGHT_NOTHING;
+        return UMBRA_SUCCESS;
+    }
+    uint32_t n = 0;
+    umbra_status st = light_ready(r, __func__, &n);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    out->kind = UMBRA_PART_LIGHT_TAU_DEPTH;
+    out->map_size = n;
+    out->channels = STATE_FLOATS;
+    out->depth_channels = 1;
+    out->tau_floats = (size_t)n * n * STATE_FLOATS;
+    out->depth_floats = (size_t)n * n;
     return UMBRA_SUCCESS;
+}
+
+/* Builds the light structure if its inputs changed (the import of tau_in is one). */
+static umbra_status build(umbra_renderer r, const char *fn, uint32_t *n)
+{
+    umbra_status st = light_ready(r, fn, n);
+    if (st == UMBRA_SUCCESS)
+        st = umbra__prepare_shadow(r, 1.0, 0);
+    if (st == UMBRA_SUCCESS && r->shadow_params.map_size != *n)
+        st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: the map built has %u texels a side, not %u", fn,
+                         r->shadow_params.map_size, *n);
+    return st;
 }
 
 umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r, float *tau_exit)
 {
     CHECK_R();
-    (void)tau_exit;
-    return light_unsupported(r, __func__);
+    const char *fn = __func__;
+    if (!tau_exit)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: tau_exit is NULL", fn);
+    uint32_t n = 0;
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    umbra_context ctx = r->ctx;
+    if ((st = build(r, fn, &n)) == UMBRA_SUCCESS && r->part_state_buf)
+        UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
+                                     (size_t)n * n * STATE_FLOATS * sizeof(float), tau_exit, 0,
+                                     NULL, NULL));
+fail:
+    umbra__call_end(r);
+    return st;
 }
 
 umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const float *tau_in)
 {
     CHECK_R();
-    (void)tau_in;
-    return light_unsupported(r, __func__);
+    const char *fn = __func__;
+    uint32_t n = 0;
+    umbra_status st = light_ready(r, fn, &n);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    const size_t floats = (size_t)n * n * STATE_FLOATS;
+    float *copy = NULL;
+    if (tau_in) {
+        for (size_t i = 0; i < floats; i += STATE_FLOATS)
+            if (!(tau_in[i] >= 0.0f && tau_in[i] <= 1.0f) || !(tau_in[i + 1] >= 0.0f))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
+                                   "transmittance product in [0, 1] and an optical depth >= 0",
+                                   fn, i / STATE_FLOATS, i / STATE_FLOATS % n,
+                                   i / STATE_FLOATS / n, tau_in[i], tau_in[i + 1]);
+        if (!(copy = malloc(floats * sizeof *copy)))
+            return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
+        memcpy(copy, tau_in, floats * sizeof *copy);
+    }
+    free(r->part_state_in);
+    r->part_state_in = copy;
+    r->part_state_floats = copy ? floats : 0;
+    r->built_valid = 0; /* the next build marches from the new state */
+    r->part_depths_valid = 0;
+    return UMBRA_SUCCESS;
 }
 
 umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float *depths)
 {
     CHECK_R();
-    (void)depths;
-    return light_unsupported(r, __func__);
+    const char *fn = __func__;
+    if (!depths)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: depths is NULL", fn);
+    uint32_t n = 0;
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    if ((st = build(r, fn, &n)) == UMBRA_SUCCESS)
+        st = umbra__map_read(r, depths, (size_t)n * n * sizeof(float));
+    umbra__call_end(r);
+    return st;
 }
 
 umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths)
 {
     CHECK_R();
-    (void)depths;
-    return light_unsupported(r, __func__);
+    const char *fn = __func__;
+    if (!depths)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: depths is NULL", fn);
+    uint32_t n = 0;
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
+        goto done;
+    for (size_t i = 0; i < (size_t)n * n; ++i)
+        if (isnan(depths[i])) {
+            st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                             "%s: texel %zu (%zu, %zu): the depth is NaN", fn, i, i % n, i / n);
+            goto done;
+        }
+    if ((st = umbra__map_write(r, depths, (size_t)n * n * sizeof(float))) == UMBRA_SUCCESS) {
+        r->part_depths_at = r->rebuilds.shadow;
+        r->part_depths_valid = 1;
+    }
+done:
+    umbra__call_end(r);
+    return st;
 }

@@ -78,16 +78,6 @@ inline float3 shadow_point(float3 p, float3 d, float h, float a)
     return p + (h * (emission_depth(a) - 0.5f * (1.0f + a))) * d;
 }
 
-#if UMBRA_PART
-/* Whether the part owns the view sample at voxel coordinates x (UmbraFrame.part_lo, part_hi):
- * the half-open core box, so a sample on a face two parts share is taken by one of them. */
-inline int part_owns(__global const UmbraFrame *F, float3 x)
-{
-    const float3 c = x + 0.5f;
-    return all(c >= F3(F->part_lo)) && all(c < F3(F->part_hi));
-}
-#endif
-
 __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const float4 *view_tf, __global const float4 *light_tf,
                              __global const uchar *view_bricks, __global const ulong *light_cells,

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "techniques/maps.h"
 #include "test_util.h"
 
 enum { NX = 40, NY = 36, NZ = 44, BS = 8, W = 48, H = 40 };
@@ -102,7 +103,8 @@ static scene make_scene(int ortho, int jitter, int shading, int point, int color
         s.camera.eye[2] = 2.0f * diag;
         s.camera.ortho_height = 1.1f * diag;
     }
-    s.light = point ? test_point_light(3.0f, 5.0f, -2.0f) : test_directional_light(0.3f, -1.0f, 0.4f);
+    s.light = point ? test_point_light(3.0f, 5.0f, -2.0f)
+                    : test_directional_light(0.3f, -1.0f, 0.4f);
     if (point == 2)
         s.light = test_point_light(80.0f, 60.0f, 90.0f);
     if (!point && ortho)
@@ -270,6 +272,145 @@ static float compare_split(umbra_context ctx, const float *voxels, umbra_transfe
 }
 
 static const uint32_t CX[] = {16}, CY[] = {24}, CZ[] = {16};
+
+/* The threshold map on parts: each part's march goes on from the state the part before it on the
+ * light's rays left (imported, exported, in light order), the depths reduce by a minimum, and
+ * every part renders with the minimum. Returns the image's largest difference and counts the
+ * depths that differ from one device's map in *differing. */
+static float compare_threshold(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
+                               const scene *s, const uint32_t ncuts[3], int extra_empty,
+                               size_t *differing)
+{
+    const uint32_t *const cuts[3] = {CX, CY, CZ};
+    umbra_part_desc parts[16];
+    const uint32_t n = make_parts(cuts, ncuts, extra_empty, umbra_part_ghost_needed(&s->opts),
+                                  parts);
+    umbra_shadow_desc sd;
+    umbra_shadow_desc_init(&sd);
+    sd.technique = UMBRA_SHADOW_THRESHOLD;
+    sd.map.size = 96;
+
+    /* One device. */
+    umbra_volume_desc d;
+    volume_desc(&d, voxels, NX, NY, NZ);
+    umbra_volume whole_v = NULL;
+    assert_int_equal(umbra_volume_create(ctx, &d, &whole_v), UMBRA_SUCCESS);
+    umbra_renderer whole_r = scene_renderer(ctx, whole_v, tf, s);
+    assert_int_equal(umbra_renderer_set_shadow(whole_r, &sd), UMBRA_SUCCESS);
+    float *whole = test_render_image(whole_r, W, H);
+    const size_t texels = (size_t)sd.map.size * sd.map.size;
+    float *whole_map = malloc(texels * sizeof *whole_map);
+    assert_non_null(whole_map);
+    assert_int_equal(umbra__map_read(whole_r, whole_map, texels * sizeof *whole_map),
+                     UMBRA_SUCCESS);
+
+    /* The parts. */
+    umbra_volume vols[16];
+    umbra_renderer rs[16];
+    umbra_volume_info info;
+    for (uint32_t i = 0; i < n; ++i) {
+        const umbra_part_desc *p = &parts[i];
+        const int empty = p->size[0] == 0;
+        uint32_t lo[3], dims[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = p->offset[a] - p->ghost_lo[a];
+            dims[a] = empty ? 1 : p->ghost_lo[a] + p->size[a] + p->ghost_hi[a];
+        }
+        float *box = sub_box(voxels, lo, dims);
+        volume_desc(&d, box, dims[0], dims[1], dims[2]);
+        assert_int_equal(umbra_volume_create_part(ctx, &d, p, &vols[i]), UMBRA_SUCCESS);
+        free(box);
+        assert_int_equal(umbra_volume_get_info(vols[i], &info), UMBRA_SUCCESS);
+        rs[i] = scene_renderer(ctx, vols[i], tf, s);
+        assert_int_equal(umbra_renderer_set_shadow(rs[i], &sd), UMBRA_SUCCESS);
+    }
+    umbra_part_light_info li = {.struct_size = sizeof li};
+    assert_int_equal(umbra_renderer_part_light_info(rs[0], &li), UMBRA_SUCCESS);
+    assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
+    assert_int_equal(li.map_size, sd.map.size);
+    float *state = malloc(li.tau_floats * sizeof *state);
+    float *depth = malloc(li.depth_floats * sizeof *depth);
+    float *acc = malloc(li.depth_floats * sizeof *acc);
+    uint32_t order[16];
+    assert_true(state && depth && acc);
+    const int point = s->light.type == UMBRA_LIGHT_POINT;
+    assert_int_equal(umbra_part_visibility_order(parts, n, &info,
+                                                 point ? s->light.position : s->light.direction,
+                                                 point, order),
+                     UMBRA_SUCCESS);
+    for (uint32_t i = 0; i < n; ++i) {
+        umbra_renderer r = rs[order[i]];
+        assert_int_equal(umbra_renderer_part_import_transmittance(r, i ? state : NULL),
+                         UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_export_transmittance(r, state), UMBRA_SUCCESS);
+    }
+    for (size_t t = 0; t < li.depth_floats; ++t)
+        acc[t] = INFINITY;
+    for (uint32_t i = 0; i < n; ++i) {
+        assert_int_equal(umbra_renderer_part_export_depths(rs[i], depth), UMBRA_SUCCESS);
+        umbra_part_minimum(acc, depth, li.depth_floats);
+    }
+    *differing = 0;
+    for (size_t t = 0; t < texels; ++t)
+        *differing += memcmp(&acc[t], &whole_map[t], sizeof acc[t]) != 0;
+    float *frame = calloc((size_t)W * H * 4, sizeof *frame);
+    float *img = malloc((size_t)W * H * 4 * sizeof *img);
+    assert_true(frame && img);
+    assert_int_equal(umbra_part_view_order(parts, n, &info, &s->camera, order), UMBRA_SUCCESS);
+    for (uint32_t i = 0; i < n; ++i) {
+        umbra_renderer r = rs[order[i]];
+        umbra_part_rect rect;
+        assert_int_equal(umbra_renderer_part_import_depths(r, acc), UMBRA_SUCCESS);
+        if (umbra_renderer_render_part(r, W, H, &rect, img) != UMBRA_SUCCESS)
+            fail_msg("part %u: %s", order[i], take_message(ctx));
+        assert_int_equal(umbra_part_composite(frame, W, H, img, &rect), UMBRA_SUCCESS);
+    }
+    umbra_part_background(frame, (size_t)W * H, s->opts.background);
+    const float diff = test_max_diff(whole, frame, (size_t)W * H * 4, NULL);
+    /* The map holds shadow: some texel has a depth. */
+    size_t hit = 0;
+    for (size_t t = 0; t < texels; ++t)
+        hit += isfinite(whole_map[t]) && whole_map[t] < 1.5f;
+    assert_true(hit > 10);
+    for (uint32_t i = 0; i < n; ++i) {
+        umbra_renderer_release(rs[i]);
+        umbra_volume_release(vols[i]);
+    }
+    umbra_renderer_release(whole_r);
+    umbra_volume_release(whole_v);
+    free(whole);
+    free(whole_map);
+    free(state);
+    free(depth);
+    free(acc);
+    free(frame);
+    free(img);
+    return diff;
+}
+
+static void test_threshold_splits_match_one_device(void **state)
+{
+    umbra_context ctx = *state;
+    float *voxels = scene_voxels();
+    umbra_transfer_function tf = scene_tf(ctx);
+    const uint32_t split_2x1x1[3] = {1, 0, 0}, split_2x2x1[3] = {1, 1, 0},
+                   split_2x2x2[3] = {1, 1, 1};
+    const uint32_t *splits[] = {split_2x1x1, split_2x2x1, split_2x2x2, split_2x1x1};
+    const int cases[][5] = {{0, 0, 0, 0, 0}, {0, 1, 1, 1, 1}, {1, 0, 1, 0, 1}, {1, 1, 0, 2, 0}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        const scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
+        for (int k = 0; k < 4; ++k) {
+            size_t differing = 0;
+            float d = compare_threshold(ctx, voxels, tf, &s, splits[k], k == 3, &differing);
+            printf("threshold case %zu split %d: max |diff| %.3g, %zu differing depths\n", c, k,
+                   (double)d, differing);
+            assert_int_equal(differing, 0);
+            assert_true(d <= PART_BOUND);
+        }
+    }
+    umbra_transfer_function_release(tf);
+    free(voxels);
+}
 
 static void test_splits_match_one_device(void **state)
 {
@@ -524,6 +665,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_input_refused),
         cmocka_unit_test(test_splits_match_one_device),
         cmocka_unit_test(test_termination_bound),
+        cmocka_unit_test(test_threshold_splits_match_one_device),
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);

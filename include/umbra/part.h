@@ -115,16 +115,24 @@ UMBRA_API umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t wid
                                                   uint32_t height, umbra_part_rect *rect,
                                                   float *rgba);
 
-/* What crosses parts along the light for the renderer's technique, in light order. */
+/* What crosses parts along the light for the renderer's technique, in light order. No technique
+ * exchanges light yet (umbra_renderer_part_light_info refuses each but none by name); the kinds
+ * say what each will export and import. */
 typedef enum umbra_part_light_kind {
     UMBRA_PART_LIGHT_NOTHING = 0,  /* no light pass (UMBRA_SHADOW_NONE): nothing to exchange */
     UMBRA_PART_LIGHT_TAU = 1,      /* deep map: export tau_exit; import tau_in, the product of
                                       the exit maps of the parts before this one on each ray */
-    UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map: export tau_exit, import tau_in (the build
-                                      then uses theta' = 1 - (1 - theta) / tau_in per texel),
-                                      export the depths, import their minimum over all parts */
-    UMBRA_PART_LIGHT_DEPTH = 3     /* CSSM: export the depths (segments indexed along the global
-                                      light ray), import their minimum over all parts */
+    UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map and CSSM: export tau_exit, import tau_in
+                                      (the threshold build then uses theta' = 1 - (1 - theta) /
+                                      tau_in per texel), export the depths, import their
+                                      minimum over all parts */
+    UMBRA_PART_LIGHT_DEPTH = 3     /* a map whose local decisions need nothing from the other
+                                      parts (segments indexed along the global light ray): export
+                                      the depths, import their minimum. umbra's CSSM is not one:
+                                      it draws one number per photon and stops it where the
+                                      optical depth from the light passes it
+                                      (kernels/techniques/cssm.cl), so its part needs tau_in
+                                      first and is of kind UMBRA_PART_LIGHT_TAU_DEPTH */
 } umbra_part_light_kind;
 
 typedef struct umbra_part_light_info {

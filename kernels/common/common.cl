@@ -59,6 +59,17 @@ inline VolGeom vol_geom(__global const UmbraFrame *F)
     return g;
 }
 
+#if UMBRA_PART
+/* Whether the part owns the sample at voxel coordinates x (UmbraFrame.part_lo, part_hi): the
+ * half-open core box, so a sample on a face two parts share is taken by one of them (view
+ * samples, kernels/raycast.cl, and light-ray segments by their midpoint). */
+inline int part_owns(__global const UmbraFrame *F, float3 x)
+{
+    const float3 c = x + 0.5f;
+    return all(c >= F3(F->part_lo)) && all(c < F3(F->part_hi));
+}
+#endif
+
 /* Slab test: the parametric interval [t0, t1] where o + t d lies in [bmin, bmax] (faces
  * included); t1 < t0 when the ray misses. Division by a zero component gives +-inf, which the
  * min/max handle where o lies off that axis' planes. On a plane it gives 0 * inf = NaN for that
