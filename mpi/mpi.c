@@ -365,26 +365,6 @@ umbra_status umbra_mpi_order(MPI_Comm comm, umbra_context ctx, const umbra_part_
 
 /* ---- light -------------------------------------------------------------------------------- */
 
-/* For a directional light along index axis a of placement (the other two components exactly
- * 0): a, else -1. */
-static int light_axis(const umbra_light *light, const umbra_volume_info *placement)
-{
-    float c[3];
-    int zero = 0, axis = -1;
-    if (light->type != UMBRA_LIGHT_DIRECTIONAL)
-        return -1;
-    for (int a = 0; a < 3; ++a) {
-        const float *d = placement->directions + 3 * a;
-        c[a] = light->direction[0] * d[0] + light->direction[1] * d[1] +
-               light->direction[2] * d[2];
-        if (c[a] == 0.0f)
-            ++zero;
-        else
-            axis = a;
-    }
-    return zero == 2 ? axis : -1;
-}
-
 umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
                              umbra_volume volume, const umbra_light *light,
                              umbra_mpi_stats *stats)
@@ -392,10 +372,10 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
     umbra_part_light_info info;
     umbra_volume_info placement;
     umbra_part_desc part, *all = NULL;
-    MPI_Comm ordered = MPI_COMM_NULL, line = MPI_COMM_NULL;
+    MPI_Comm ordered = MPI_COMM_NULL;
     float *tau = NULL, *tau_in = NULL, *depth = NULL;
     uint32_t *order = NULL;
-    int count = 0, pos = 0, axis;
+    int count = 0, pos = 0;
     double t;
     umbra_status st;
 
@@ -440,25 +420,11 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
     st = split_in_order(comm, ctx, order, count, &ordered);
     if (st != UMBRA_SUCCESS)
         goto fail;
-    axis = light_axis(light, &placement);
-    {
-        int me = 0, color = 0;
-        MPI_Comm_rank(ordered, &pos);
-        MPI_Comm_rank(comm, &me);
-        if (axis >= 0) {
-            /* The lowest rank whose part has the same offsets across the axis names the
-             * column. */
-            int b = (axis + 1) % 3, c = (axis + 2) % 3;
-            for (color = 0; color < count; ++color)
-                if (all[color].offset[b] == part.offset[b] && all[color].offset[c] == part.offset[c])
-                    break;
-        }
-        MPI_Comm_split(ordered, color, pos, &line);
-    }
+    MPI_Comm_rank(ordered, &pos);
 
-    /* Transmittance: export, exclusive prefix product in light order, import. */
-    if (info.tau_floats) {
-        int first = 0;
+    if (info.kind == UMBRA_PART_LIGHT_TAU) {
+        /* Deep map: each part's own exit transmittance, the exclusive prefix product in light
+         * order (a ray that misses a part is multiplied by its 1), imported. */
         t = now_ms();
         st = agree(comm, ctx, umbra_renderer_part_export_transmittance(r, tau));
         if (stats)
@@ -466,14 +432,52 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
         if (st != UMBRA_SUCCESS)
             goto fail;
         t = now_ms();
-        MPI_Exscan(tau, tau_in, (int)info.tau_floats, MPI_FLOAT, MPI_PROD, line);
-        MPI_Comm_rank(line, &first);
+        MPI_Exscan(tau, tau_in, (int)info.tau_floats, MPI_FLOAT, MPI_PROD, ordered);
         if (stats) {
             stats->light_exchange_ms += now_ms() - t;
             stats->bytes_sent += info.tau_floats * sizeof *tau;
         }
-        st = agree(comm, ctx,
-                   umbra_renderer_part_import_transmittance(r, first == 0 ? NULL : tau_in));
+        st = agree(comm, ctx, umbra_renderer_part_import_transmittance(r, pos == 0 ? NULL : tau_in));
+        if (st != UMBRA_SUCCESS)
+            goto fail;
+    } else if (info.tau_floats) {
+        /* Threshold map and CSSM: the march state goes on from part to part in light order
+         * (import what the part before left, march, export for the next), so the parts pass it
+         * down the chain of the ordered ranks. A rank that fails passes its status on instead,
+         * and the chain still ends; the agreement after it reports the first failure. */
+        int size = 1;
+        float flag = 0.0f;
+        MPI_Comm_size(ordered, &size);
+        st = UMBRA_SUCCESS;
+        if (pos > 0) {
+            double w = now_ms();
+            MPI_Recv(tau_in, (int)info.tau_floats, MPI_FLOAT, pos - 1, 0, ordered,
+                     MPI_STATUS_IGNORE);
+            MPI_Recv(&flag, 1, MPI_FLOAT, pos - 1, 1, ordered, MPI_STATUS_IGNORE);
+            if (stats)
+                stats->light_exchange_ms += now_ms() - w;
+            if (flag != 0.0f)
+                st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                          "umbra_mpi_light: a rank before this one in light order failed");
+        }
+        t = now_ms();
+        if (st == UMBRA_SUCCESS)
+            st = umbra_renderer_part_import_transmittance(r, pos == 0 ? NULL : tau_in);
+        if (st == UMBRA_SUCCESS)
+            st = umbra_renderer_part_export_transmittance(r, tau);
+        if (stats)
+            stats->build_ms += now_ms() - t;
+        if (pos + 1 < size) {
+            double w = now_ms();
+            flag = st == UMBRA_SUCCESS ? 0.0f : 1.0f;
+            MPI_Send(tau, (int)info.tau_floats, MPI_FLOAT, pos + 1, 0, ordered);
+            MPI_Send(&flag, 1, MPI_FLOAT, pos + 1, 1, ordered);
+            if (stats) {
+                stats->light_exchange_ms += now_ms() - w;
+                stats->bytes_sent += info.tau_floats * sizeof *tau + sizeof flag;
+            }
+        }
+        st = agree(comm, ctx, st);
         if (st != UMBRA_SUCCESS)
             goto fail;
     }
@@ -486,7 +490,7 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
         if (st != UMBRA_SUCCESS)
             goto fail;
         t = now_ms();
-        MPI_Allreduce(MPI_IN_PLACE, depth, (int)info.depth_floats, MPI_FLOAT, MPI_MIN, line);
+        MPI_Allreduce(MPI_IN_PLACE, depth, (int)info.depth_floats, MPI_FLOAT, MPI_MIN, ordered);
         if (stats) {
             stats->light_exchange_ms += now_ms() - t;
             stats->bytes_sent += info.depth_floats * sizeof *depth;
@@ -494,8 +498,6 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
         st = agree(comm, ctx, umbra_renderer_part_import_depths(r, depth));
     }
 fail:
-    if (line != MPI_COMM_NULL)
-        MPI_Comm_free(&line);
     if (ordered != MPI_COMM_NULL)
         MPI_Comm_free(&ordered);
     free(depth);

@@ -8,10 +8,10 @@
  *   - the split of the global grid into px x py x pz parts on the brick grid, one per rank;
  *   - each rank reading only its part of the file (umbra_volume_read_box), with ghost layers,
  *     and the value range agreed over all ranks;
- *   - the light data in light order: an exclusive prefix product of exit transmittances
- *     (MPI_Exscan, MPI_PROD), over column communicators (MPI_Comm_split) for a light along a grid
- *     axis and over all ranks in light order otherwise, and a minimum of depths (MPI_Allreduce,
- *     MPI_MIN);
+ *   - the light data in light order, over the ranks renumbered in light order (MPI_Comm_split):
+ *     for the deep map an exclusive prefix product of exit transmittances (MPI_Exscan,
+ *     MPI_PROD); for the threshold map and CSSM the march state passed down that order, part to
+ *     part; then a minimum of depths (MPI_Allreduce, MPI_MIN);
  *   - the view composited in visibility order: MPI_Reduce_scatter_block with a non-commutative
  *     "over" MPI_Op on a communicator whose ranks are ordered front to back, then a gather; or,
  *     sequentially, every partial image gathered and composited front to back in one place.
@@ -122,11 +122,13 @@ UMBRA_API umbra_status umbra_mpi_order(MPI_Comm comm, umbra_context ctx,
 
 /* Collective: the light passes of renderer r (its part volume, transfer functions, technique and
  * light set; volume and light the ones set on r) and the exchange between them, as
- * umbra_renderer_part_light_info says: tau_in of each part is the product of the exit
- * transmittances of the parts before it in light order (MPI_Exscan with MPI_PROD: over the
- * column of parts along the axis for a directional light along a grid axis, over all ranks in
- * light order otherwise), imported; then the depths' minimum (MPI_Allreduce, MPI_MIN over the
- * same ranks), imported. After it r renders its part (umbra_mpi_render). Nothing to do for
+ * umbra_renderer_part_light_info says, on comm's ranks in light order: for UMBRA_PART_LIGHT_TAU
+ * tau_in of each part is the product of the exit transmittances of the parts before it
+ * (MPI_Exscan with MPI_PROD), imported; for UMBRA_PART_LIGHT_TAU_DEPTH each part imports the
+ * march state the part before it exported and exports its own for the next (MPI_Recv, MPI_Send:
+ * P - 1 steps one after the other); then the depths' minimum over all ranks (MPI_Allreduce,
+ * MPI_MIN), imported. Whole maps cross: a lookup near a part's rim reads texels whose rays pass
+ * through other parts, so no rank's share is cut to its own column of parts. After it r renders its part (umbra_mpi_render). Nothing to do for
  * UMBRA_SHADOW_NONE. stats (may be NULL) gets build_ms, light_exchange_ms and bytes_sent added. */
 UMBRA_API umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
                                        umbra_volume volume, const umbra_light *light,
