@@ -137,12 +137,7 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s does not split into parts: its slices carry the light "
                            "over the whole view depth", fn, tech);
-    case UMBRA_SHADOW_THRESHOLD:
-        if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
-            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: technique %s: import the depths of all parts "
-                               "(umbra_renderer_part_import_depths) after the last light build",
-                               fn, tech);
+    case UMBRA_SHADOW_THRESHOLD: /* after its exchange: render_part checks */
         break;
     case UMBRA_SHADOW_CSSM:
     case UMBRA_SHADOW_DEEP:
@@ -231,6 +226,16 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
+    /* A light build now (if its inputs changed) would overwrite the imported depths. */
+    if (r->shadow_set.technique == UMBRA_SHADOW_THRESHOLD) {
+        if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
+            return st;
+        if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: technique threshold: import the depths of all parts "
+                               "(umbra_renderer_part_import_depths) after the last light build",
+                               fn);
+    }
     umbra__frame_update_light(r);
     umbra__frame_update_view(r, width, height);
     umbra_part_rect rect;

@@ -9,14 +9,18 @@
  *    one ray's running sum), for a perspective camera looking obliquely and an orthographic one
  *    along an axis, jitter on and off, shading on and off, grey and coloured light, directional
  *    along an axis and oblique, a point light inside and outside the box;
- *  - with early ray termination (0.99) the difference is at most 1 - termination;
+ *  - with early ray termination (0.9) the difference is at most 1 - termination;
+ *  - the threshold map on parts: the march state passed on in light order
+ *    (umbra_part_visibility_order from the light), the depths reduced by umbra_part_minimum:
+ *    the map equals one device's depth for depth (0 differing), the image within PART_BOUND;
  *  - the host helpers: the visibility order of a 2x2x2 grid from a point and along a direction,
  *    the over operator, the product and minimum;
  *  - bad input, refused naming the value, the context usable after: an offset off the brick
  *    grid, a part that overflows the global grid, dims that do not match, no given value range,
  *    too few ghost layers, the techniques that do not split (reference, convolution) and those
  *    not yet part-aware, the ground plane, a projection mode, a part rendered with
- *    umbra_renderer_render.
+ *    umbra_renderer_render, a threshold part rendered before its depths were imported or after
+ *    the light changed, a NaN depth and a transmittance above 1 (each naming the texel).
  * Usage: test_part [filter] (a cmocka test-name glob). */
 #include <math.h>
 #include <stdio.h>
@@ -629,7 +633,6 @@ static void test_bad_input_refused(void **state)
     } refused[] = {{UMBRA_SHADOW_REFERENCE, "technique reference does not split"},
                    {UMBRA_SHADOW_CONVOLUTION, "technique convolution does not split"},
                    {UMBRA_SHADOW_MOMENTS, "technique moments is refused on a part"},
-                   {UMBRA_SHADOW_THRESHOLD, "technique threshold is not part-aware"},
                    {UMBRA_SHADOW_CSSM, "technique cssm is not part-aware"},
                    {UMBRA_SHADOW_DEEP, "technique deep is not part-aware"}};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i) {
@@ -639,6 +642,39 @@ static void test_bad_input_refused(void **state)
         assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
         test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
                            UMBRA_ERROR_UNSUPPORTED, refused[i].needle, NULL);
+    }
+    /* The threshold map renders on a part only after the exchange, and again after a light
+     * change. */
+    {
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_THRESHOLD;
+        sd.map.size = 64;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "import the depths", NULL);
+        umbra_part_light_info li = {.struct_size = sizeof li};
+        assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
+        float *dep = malloc(li.depth_floats * sizeof *dep);
+        float *st = malloc(li.tau_floats * sizeof *st);
+        assert_true(dep && st);
+        assert_int_equal(umbra_renderer_part_export_depths(r, dep), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_import_depths(r, dep), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_render_part(r, W, H, &rect, img), UMBRA_SUCCESS);
+        umbra_light l = test_directional_light(1.0f, -1.0f, 0.0f);
+        assert_int_equal(umbra_renderer_set_light(r, &l), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "after the last light build", NULL);
+        dep[5] = NAN;
+        test_assert_failed(ctx, umbra_renderer_part_import_depths(r, dep),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 5 (5, 0)", "NaN");
+        for (size_t i = 0; i < li.tau_floats; ++i)
+            st[i] = 0.5f;
+        st[2 * 7] = 1.5f;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, st),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 7 (7, 0)", "[0, 1]");
+        free(dep);
+        free(st);
     }
     /* A whole volume is not a part. */
     umbra_renderer_release(r);

@@ -24,10 +24,11 @@
  *
  * What a part renders:
  *   - UMBRA_SHADOW_NONE, every option but those listed as refused below;
- *   - the light-space techniques need what crosses parts along the light (the exit
- *     transmittance, the incoming transmittance tau_in, the stored depths); the functions that
- *     export and import them are declared below, and return UMBRA_ERROR_UNSUPPORTED naming the
- *     technique until it implements them (umbra_renderer_part_light_info says which do);
+ *   - UMBRA_SHADOW_THRESHOLD, after the light exchange below: its map equals one device's map of
+ *     the whole volume, depth for depth;
+ *   - CSSM and the deep map need the same kind of exchange (what crosses parts along the light:
+ *     the transmittance reaching a part, the stored depths); they return UMBRA_ERROR_UNSUPPORTED
+ *     naming the technique until they implement it (umbra_renderer_part_light_info);
  *   - refused on a part, each with UMBRA_ERROR_UNSUPPORTED naming the reason: the exact
  *     reference (shadow rays would cross parts) and convolution (slices over the whole view
  *     depth): they do not split; moments; the projection modes (MIP, MinIP, average); volumes
@@ -115,9 +116,9 @@ UMBRA_API umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t wid
                                                   uint32_t height, umbra_part_rect *rect,
                                                   float *rgba);
 
-/* What crosses parts along the light for the renderer's technique, in light order. No technique
- * exchanges light yet (umbra_renderer_part_light_info refuses each but none by name); the kinds
- * say what each will export and import. */
+/* What crosses parts along the light for the renderer's technique, in light order. The threshold
+ * map exchanges light (UMBRA_PART_LIGHT_TAU_DEPTH); CSSM and the deep map are refused by name
+ * for now, and the kinds say what each will export and import. */
 typedef enum umbra_part_light_kind {
     UMBRA_PART_LIGHT_NOTHING = 0,  /* no light pass (UMBRA_SHADOW_NONE): nothing to exchange */
     UMBRA_PART_LIGHT_TAU = 1,      /* deep map: export tau_exit; import tau_in, the product of
@@ -140,7 +141,9 @@ typedef struct umbra_part_light_info {
     umbra_part_light_kind kind;
     uint32_t map_size;             /* texels per side of the light-space map (one frame for all
                                       parts: fitted to the global box) */
-    uint32_t channels;             /* floats per texel of the tau arrays: 1 grey, 3 coloured */
+    uint32_t channels;             /* floats per texel of the transmittance arrays: for the
+                                      threshold map 2, its march's state (the product of the
+                                      whole segments' 1 - alpha and an optical depth) */
     uint32_t depth_channels;       /* floats per texel of the depth arrays */
     size_t tau_floats;             /* map_size^2 * channels, or 0 */
     size_t depth_floats;           /* map_size^2 * depth_channels, or 0 */
@@ -152,23 +155,34 @@ typedef struct umbra_part_light_info {
 UMBRA_API umbra_status umbra_renderer_part_light_info(umbra_renderer r,
                                                       umbra_part_light_info *out);
 
-/* Light pass 1: marches the part's own segment of every light ray and writes its exit
- * transmittance per texel (info.tau_floats floats, texel (u, v) at (v * map_size + u) *
- * channels; 1 where the ray misses the part). */
+/* Light pass 1: marches the part's own segments of every light ray (those whose midpoint its
+ * core owns, at the global ray's t0 + (k + 1/2) step), going on from the imported state, and
+ * writes the state at their end per texel (info.tau_floats floats, texel (u, v) at
+ * (v * map_size + u) * channels; the imported state where the ray misses the part). The state
+ * is the light's from the light to the part's exit, not the part's own, so parts pass it on in
+ * light order: the part after this one on a texel's ray imports this part's export. Walking
+ * the parts in umbra_part_visibility_order from the light, each importing the array the one
+ * before exported, does that for every texel at once; the march is then one device's, bit for
+ * bit (a product of the parts' own transmittances, umbra_part_multiply, would round
+ * differently). Builds (blocks) when the light inputs or the imported state changed. */
 UMBRA_API umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r, float *tau_exit);
 
-/* Sets tau_in, the transmittance reaching the part along each light ray (info.tau_floats floats,
- * each in [0, 1]; NULL: 1 everywhere, the first part on every ray). Copied. Values outside
- * [0, 1] or NaN are refused naming the texel. */
+/* Sets the state reaching the part along each light ray (info.tau_floats floats, as the part
+ * before it exported them; NULL: the light's, transmittance 1, for the first part on every
+ * ray). Copied; the next build marches from it. A transmittance outside [0, 1], a negative
+ * optical depth or NaN is refused naming the texel. */
 UMBRA_API umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r,
                                                                 const float *tau_in);
 
-/* Builds the part's depth map (after the import of tau_in for the threshold map) and writes its
- * depths (info.depth_floats floats; +infinity where nothing happens in the part). */
+/* Builds the part's depth map if needed (after the import of the state for the threshold map)
+ * and writes its depths (info.depth_floats floats; the map's "never" depth where nothing happens
+ * in the part). */
 UMBRA_API umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float *depths);
 
 /* Sets the depths the lookups compare against: the element-wise minimum of all parts' exported
- * depths (umbra_part_minimum). Copied. NaN is refused naming the texel. */
+ * depths (umbra_part_minimum). Copied into the built map. NaN is refused naming the texel. A
+ * part renders a threshold map only after this import, and only while no light input has
+ * changed since (else UMBRA_ERROR_INVALID_ARGUMENT: exchange again). */
 UMBRA_API umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths);
 
 /* ---- Host helpers: pure functions on the arrays above (no context, no device). ---- */
