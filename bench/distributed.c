@@ -120,9 +120,9 @@ static int write_volume(const char *dir, uint32_t n)
 
 int bench_distributed(int argc, char **argv)
 {
-    const char *mpi_dir = NULL, *results = NULL, *technique = "deep";
+    const char *mpi_dir = NULL, *results = NULL, *technique = "threshold";
     uint32_t n = 128, image = 256;
-    for (int i = 2; i < argc; ++i) {
+    for (int i = 1; i < argc; ++i) {
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(argv[i], "--mpi") == 0 && v) {
             mpi_dir = v;
@@ -142,7 +142,7 @@ int bench_distributed(int argc, char **argv)
                    "  --mpi BUILD    a build directory made with -DUMBRA_WITH_MPI=ON (its "
                    "umbra-render-mpi)\n"
                    "  --results DIR  also write DIR/distributed.csv, .md and .png\n"
-                   "  --technique T  none, threshold, cssm or deep (default deep)\n"
+                   "  --technique T  a technique umbra-render-mpi splits (default threshold)\n"
                    "  --n N          the volume's edge in voxels (default 128, float32)\n");
             return strcmp(argv[i], "--help") == 0 ? 0 : 2;
         }
@@ -188,7 +188,7 @@ int bench_distributed(int argc, char **argv)
     if (m && rc == 0) {
         const double vol = (double)n * n * n * 4, img = (double)image * image * 16;
         fprintf(m, "# umbra-bench distributed\n\n"
-                   "`umbra-bench distributed --mpi build-mpi --results bench/results`: "
+                   "`umbra-bench distributed --mpi build-mpi --results bench/results --technique %s`: "
                    "umbra-render-mpi, technique %s, a %u^3 float32 volume (%.2f MiB), map "
                    "256^2, image %u^2 (%.2f MiB of float RGBA), P ranks oversubscribed on this "
                    "machine's cores (times: the work of each stage with the ranks sharing the "
@@ -198,7 +198,7 @@ int bench_distributed(int argc, char **argv)
                    "| P | volume MiB per rank (max) | x P / whole | sent per rank, MiB | payload "
                    "per rank, MiB | load ms | light exchange ms | build ms | render ms | "
                    "composite ms |\n|---|---|---|---|---|---|---|---|---|---|\n",
-                technique, n, vol / 1048576.0, image, img / 1048576.0);
+                technique, technique, n, vol / 1048576.0, image, img / 1048576.0);
         for (int k = 0; k < 4; ++k) {
             double vmax = 0, sent = 0, pay = 0, t[5] = {0, 0, 0, 0, 0};
             for (int r = 0; r < ps[k]; ++r) {
