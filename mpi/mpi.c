@@ -206,7 +206,6 @@ umbra_status umbra_mpi_load(MPI_Comm comm, umbra_context ctx, const char *path,
     umbra_volume_box_desc box;
     void *voxels = NULL;
     umbra_status st;
-    char msg[MSG] = "";
     double lo = 0, hi = 0, g[2];
     size_t voxel_count = 1;
 
@@ -284,7 +283,6 @@ umbra_status umbra_mpi_load(MPI_Comm comm, umbra_context ctx, const char *path,
         }
         st = umbra_volume_create_part(ctx, &vd, &out->part, &out->volume);
     }
-    (void)msg;
     st = agree(comm, ctx, st);
 fail:
     free(voxels);
@@ -685,8 +683,9 @@ umbra_status umbra_mpi_render(MPI_Comm comm, umbra_context ctx, umbra_renderer r
         st = split_in_order(comm, ctx, order, count, &ordered);
     if (st != UMBRA_SUCCESS)
         goto fail;
-    /* root, a rank of comm, in the view-ordered communicator. */
+    /* root, a rank of comm, in the view-ordered communicator (-1: none, refused there). */
     MPI_Comm_rank(comm, &me);
+    oroot = -1;
     for (int i = 0; i < count; ++i)
         if (order[i] == (uint32_t)root)
             oroot = i;

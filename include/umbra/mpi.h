@@ -101,7 +101,7 @@ typedef struct umbra_mpi_volume {
 
 /* Collective (the same path, file, split and range on every rank): every rank reads the header
  * of path, splits its grid (umbra_mpi_split), reads only its part's box (core and ghosts) of the
- * file (umbra_volume_read_box: NRRD raw or gzip, Voreen .dat, raw with file->raw), agrees the
+ * file (umbra_volume_read_box: NRRD, NIfTI, MetaImage, Voreen .dat, raw with file->raw), agrees the
  * value range (range NULL: the minimum and maximum over all ranks' cores, as one device computes
  * it of the whole volume; else range[0], range[1]) and makes its part volume on ctx. file (may
  * be NULL: the defaults) gives file->raw and file->options; its box is not used. stats (may be

@@ -224,6 +224,18 @@ static void run_scene(MPI_Comm comm, umbra_context ctx, umbra_volume part,
     umbra_renderer_release(r);
 }
 
+/* The split of the tests: grid, their bricks, the ghosts shading needs. */
+static void split_for(umbra_mpi_split_desc *split, const uint32_t grid[3])
+{
+    umbra_render_desc opts;
+    umbra_render_desc_init(&opts);
+    opts.shading = 1;
+    umbra_mpi_split_desc_init(split);
+    memcpy(split->grid, grid, 3 * sizeof *grid);
+    split->brick_size = BS;
+    split->ghost = umbra_part_ghost_needed(&opts);
+}
+
 /* This rank's part of the analytic volume, and rank 0's whole one. */
 static umbra_status make_part(MPI_Comm comm, umbra_context ctx, int empty, const uint32_t grid[3],
                               umbra_volume *part, umbra_volume *whole)
@@ -232,14 +244,8 @@ static umbra_status make_part(MPI_Comm comm, umbra_context ctx, int empty, const
     umbra_mpi_split_desc split;
     umbra_part_desc p;
     umbra_volume_desc d;
-    umbra_render_desc opts;
     umbra_status st;
-    umbra_render_desc_init(&opts);
-    opts.shading = 1;
-    umbra_mpi_split_desc_init(&split);
-    memcpy(split.grid, grid, sizeof split.grid);
-    split.brick_size = BS;
-    split.ghost = umbra_part_ghost_needed(&opts);
+    split_for(&split, grid);
     st = umbra_mpi_split(comm, ctx, dims, &split, &p, NULL);
     if (st != UMBRA_SUCCESS)
         return st;
@@ -333,14 +339,8 @@ static void test_file(MPI_Comm comm, umbra_context ctx, const uint32_t grid[3], 
     umbra_mpi_split_desc split;
     umbra_mpi_volume mv;
     umbra_mpi_stats stats;
-    umbra_render_desc opts;
     memset(&stats, 0, sizeof stats);
-    umbra_render_desc_init(&opts);
-    opts.shading = 1;
-    umbra_mpi_split_desc_init(&split);
-    memcpy(split.grid, grid, sizeof split.grid);
-    split.brick_size = BS;
-    split.ghost = umbra_part_ghost_needed(&opts);
+    split_for(&split, grid);
     umbra_status st = umbra_mpi_load(comm, ctx, hdr, NULL, &split, NULL, &mv, &stats);
     CHECK(st == UMBRA_SUCCESS, "umbra_mpi_load: %s", umbra_context_last_message(ctx));
     if (st != UMBRA_SUCCESS)
