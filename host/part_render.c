@@ -391,24 +391,36 @@ static umbra_status build(umbra_renderer r, const char *fn, uint32_t *n)
     return st;
 }
 
-umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r, float *tau_exit)
+/* The exports: builds if needed, then reads the march state (depths 0) or the depth map. */
+static umbra_status export_light(umbra_renderer r, const char *fn, float *out, int depths)
 {
-    CHECK_R();
-    const char *fn = __func__;
-    if (!tau_exit)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: tau_exit is NULL", fn);
+    if (!out)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: the array is NULL", fn);
     uint32_t n = 0;
     umbra_status st = umbra__call_begin(r, fn);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra_context ctx = r->ctx;
-    if ((st = build(r, fn, &n)) == UMBRA_SUCCESS && r->part_state_buf)
+    if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
+        goto fail;
+    if (depths) {
+        st = umbra__map_read(r, out, (size_t)n * n * sizeof(float));
+    } else if (!r->part_state_buf) {
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: no march state was built", fn);
+    } else {
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
-                                     (size_t)n * n * STATE_FLOATS * sizeof(float), tau_exit, 0,
-                                     NULL, NULL));
+                                     (size_t)n * n * STATE_FLOATS * sizeof(float), out, 0, NULL,
+                                     NULL));
+    }
 fail:
     umbra__call_end(r);
     return st;
+}
+
+umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r, float *tau_exit)
+{
+    CHECK_R();
+    return export_light(r, __func__, tau_exit, 0);
 }
 
 umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const float *tau_in)
@@ -444,17 +456,7 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
 umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float *depths)
 {
     CHECK_R();
-    const char *fn = __func__;
-    if (!depths)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: depths is NULL", fn);
-    uint32_t n = 0;
-    umbra_status st = umbra__call_begin(r, fn);
-    if (st != UMBRA_SUCCESS)
-        return st;
-    if ((st = build(r, fn, &n)) == UMBRA_SUCCESS)
-        st = umbra__map_read(r, depths, (size_t)n * n * sizeof(float));
-    umbra__call_end(r);
-    return st;
+    return export_light(r, __func__, depths, 1);
 }
 
 umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths)
