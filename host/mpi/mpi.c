@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* mpi/mpi.c: umbra_mpi (include/umbra/mpi.h), the communication around libumbra's parts.
+/* host/mpi/mpi.c: umbra_mpi (include/umbra/mpi.h), the communication around libumbra's parts.
  *
  * Everything is collective and every failure is agreed (umbra_mpi_agree) before the next
  * exchange, so a rank that fails never leaves the others waiting in a collective it will not
