@@ -31,6 +31,7 @@ int bench_convolution(int argc, char **argv); /* bench/convolution.c */
 int bench_accuracy(int argc, char **argv); /* bench/accuracy.c */
 int bench_readme(int argc, char **argv);   /* bench/readme.c */
 int bench_scale(int argc, char **argv);    /* bench/scale.c */
+int bench_distributed(int argc, char **argv); /* bench/distributed.c */
 int bench_interactive(int argc, char **argv); /* bench/interactive.c */
 int bench_builds(int argc, char **argv);   /* bench/builds.c */
 int bench_conformance(int argc, char **argv); /* bench/conformance.c */

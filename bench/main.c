@@ -28,6 +28,8 @@ static const bench_command commands[] = {
      "the cost of clipping, projection modes, channels, label maps and volume updates (#31)"},
     {"scale", bench_scale,
      "time to first frame, frame times and memory against volume size (128^3 .. 1024^3 and up)"},
+    {"distributed", bench_distributed,
+     "umbra-render-mpi on 1-8 ranks: volume bytes, bytes sent and stage times per rank"},
 };
 
 static void usage(FILE *f)

@@ -106,21 +106,34 @@ static umbra_status load_tf(umbra_context ctx, const char *path, const char *pre
     return umbra_transfer_function_load(ctx, path, out);
 }
 
-int session_begin(const options *o, session *s)
+umbra_status session_open(const options *o, session *s, int quiet)
 {
     umbra_context_desc cd;
     umbra_context_desc_init(&cd);
     cd.device_name = o->device;
     cd.platform_index = o->platform_index;
     cd.device_index = o->device_index;
-    cd.error_callback = on_error;
-    cd.error_user = (void *)o->program; /* only read: a string with the program's life */
+    if (!quiet) {
+        cd.error_callback = on_error;
+        cd.error_user = (void *)o->program; /* only read: a string with the program's life */
+    }
     umbra_status st = umbra_context_create(&cd, &s->ctx);
+    if (st == UMBRA_SUCCESS && !quiet)
+        fprintf(stderr, "device: %s\n", umbra_context_device_name(s->ctx));
+    return st;
+}
+
+int session_begin(const options *o, session *s)
+{
+    umbra_status st = session_open(o, s, 0);
     if (st != UMBRA_SUCCESS)
         return exit_status(st);
-    fprintf(stderr, "device: %s\n", umbra_context_device_name(s->ctx));
-    double t0 = 0;
-    (void)t0;
+    return session_setup(o, s);
+}
+
+int session_setup(const options *o, session *s)
+{
+    umbra_status st;
     umbra_volume vol = NULL;
     umbra_transfer_function tf = NULL;
     umbra_render_desc rd;
@@ -132,8 +145,10 @@ int session_begin(const options *o, session *s)
         umbra_volume_load_options_init(&lo);
         lo.data_roots = o->data_roots;
         lo.data_root_count = o->data_root_count;
-        st = o->volume ? umbra_volume_load_with_options(s->ctx, o->volume, &lo, &s->volume)
-                       : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
+        /* A volume the caller made (umbra-render-mpi: this rank's part) is used as given. */
+        st = s->volume ? UMBRA_SUCCESS
+             : o->volume ? umbra_volume_load_with_options(s->ctx, o->volume, &lo, &s->volume)
+                         : umbra_volume_load_raw(s->ctx, o->raw, &o->raw_desc, &s->volume);
         if (st != UMBRA_SUCCESS)
             return exit_status(st);
         vol = s->volume;
@@ -218,6 +233,7 @@ int session_begin(const options *o, session *s)
     if (o->have_light_color) memcpy(light.color, o->light_color, sizeof light.color);
     if (o->have_ambient) rd.ambient[0] = rd.ambient[1] = rd.ambient[2] = o->ambient;
     if (o->have_step) rd.step = o->step;
+    if (o->have_termination) rd.termination = o->termination;
     if (o->shading >= 0) rd.shading = o->shading;
     if (o->ground >= 0) rd.ground_plane = o->ground;
     if (o->colored >= 0) rd.transmission = o->colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;

@@ -27,6 +27,8 @@ typedef struct options {
     int have_camera_dir, have_eye, have_target, have_up;
     float light_dir[3], light_pos[3], light_color[3], ambient, step, background[4];
     int have_light_dir, have_light_pos, have_light_color, have_ambient, have_step;
+    float termination;                                              /* --termination */
+    int have_termination;
     float tf_range[2];
     int have_tf_range;
     int shading, ground, colored, jitter, have_seed, have_background; /* -1: scene default */
@@ -104,6 +106,12 @@ typedef struct session {
  * render. Returns 0 or umbra-render's exit status (the message is on stderr). s must be zeroed
  * first and is released with session_end either way. */
 int session_begin(const options *o, session *s);
+/* session_begin in two steps: session_open makes s->ctx (quiet: no error callback, nothing
+ * printed; the status is returned, the message is on the context when there is one), and
+ * session_setup does the rest; a volume already in s->volume (made on s->ctx by the caller) is
+ * used instead of o->volume or o->raw, which must still name it. */
+umbra_status session_open(const options *o, session *s, int quiet);
+int session_setup(const options *o, session *s);
 void session_end(session *s);
 
 /* umbra-render's exit status for a failed library call: 1 bad input, 2 device or memory. */

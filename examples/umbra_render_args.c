@@ -152,7 +152,7 @@ enum {
     OPT_LIGHT_COLOR, OPT_AMBIENT, OPT_STEP, OPT_SHADING, OPT_NO_SHADING, OPT_GROUND,
     OPT_NO_GROUND, OPT_COLORED, OPT_GREY, OPT_BACKGROUND, OPT_JITTER, OPT_SEED, OPT_PREINTEGRATED,
     OPT_DEVICE, OPT_PROGRESS, OPT_NO_PROGRESS, OPT_INTERACTION, OPT_MODE, OPT_CLIP_PLANE, OPT_CROP,
-    OPT_RAW_CHANNELS, OPT_LABELS, OPT_CHANNEL_TF,
+    OPT_RAW_CHANNELS, OPT_LABELS, OPT_CHANNEL_TF, OPT_TERMINATION,
     OPT_PARAM = 1024,  /* + the index of a technique option */
     OPT_PROGRAM = 2048 /* + the index of an option of the program's own (parse_args_as) */
 };
@@ -215,6 +215,8 @@ static const fixed_option fixed[] = {
     {"light-color", OPT_LIGHT_COLOR, "R,G,B", "light colour (default 1,1,1)"},
     {"ambient", OPT_AMBIENT, "A", "ambient light (default 0.2)"},
     {"step", OPT_STEP, "S", "view sampling step in voxels (default 0.5)"},
+    {"termination", OPT_TERMINATION, "T", "early ray termination once the opacity passes T, in "
+                                          "(0, 1]; 1: none (default 0.99)"},
     {"shading", OPT_SHADING, NULL, "Blinn-Phong gradient shading (--no-shading: none)"},
     {"no-shading", OPT_NO_SHADING, NULL, NULL},
     {"ground", OPT_GROUND, NULL, "opaque ground plane receiving shadows (--no-ground: none)"},
@@ -748,6 +750,11 @@ int parse_args_as(const program *p, int argc, char **argv, options *o)
             if (!parse_floats(v, &o->step, 1))
                 FAIL("--step '%s' is not a number", v);
             o->have_step = 1;
+            break;
+        case OPT_TERMINATION:
+            if (!parse_floats(v, &o->termination, 1))
+                FAIL("--termination '%s' is not a number", v);
+            o->have_termination = 1;
             break;
         case OPT_BACKGROUND:
             if (!parse_floats(v, o->background, 4))

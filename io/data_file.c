@@ -242,13 +242,13 @@ umbra_status umbra_volume_load_with_options(umbra_context ctx, const char *path,
     }
     /* The formats with detached data; every other one has nothing to allow. */
     if (ends_with_nocase(path, ".nrrd") || ends_with_nocase(path, ".nhdr")) {
-        return umbra__volume_load_nrrd(ctx, path, options, out);
+        return umbra__volume_load_nrrd(ctx, path, options, NULL, out);
     }
     if (ends_with_nocase(path, ".mha") || ends_with_nocase(path, ".mhd")) {
-        return umbra__volume_load_metaimage(ctx, path, options, out);
+        return umbra__volume_load_metaimage(ctx, path, options, NULL, out);
     }
     if (ends_with_nocase(path, ".dat")) {
-        return umbra__volume_load_dat(ctx, path, options, out);
+        return umbra__volume_load_dat(ctx, path, options, NULL, out);
     }
     return umbra_volume_load(ctx, path, out);
 }

@@ -71,15 +71,45 @@ umbra_status umbra__data_file_open(umbra_context ctx, const char *func, const ch
                                    const char *name, const umbra_volume_load_options *options,
                                    char **shown, FILE **out, size_t *size);
 
+/* A request of umbra_volume_read_box (io/box.c): the box to read, where its header and voxels go. */
+typedef struct umbra__box {
+    const umbra_volume_box_desc *desc;
+    umbra_volume_file_info *info;
+    void **voxels;
+} umbra__box;
+
+/* Nonzero when box asks for the header only (its size all 0). */
+int umbra__box_header_only(const umbra__box *box);
+/* Fills box->info from what a header declares and checks the box lies in dims. */
+umbra_status umbra__box_info(umbra_context ctx, const char *func, const umbra__box *box,
+                             umbra_scalar_type type, const uint32_t dims[3],
+                             const float spacing[3], const float *origin,
+                             const float *directions, uint32_t channels);
+/* Reads box's voxels of a dims grid (voxel_bytes each) from f, whose position is the data's start:
+ * raw (compressed 0), or a gzip or zlib stream of `compressed` bytes whose first skip inflated bytes
+ * precede the voxels. swap_width > 1 swaps each value of that many bytes. */
+umbra_status umbra__box_read(umbra_context ctx, const char *func, const char *name, FILE *f,
+                             size_t compressed, size_t skip, const uint32_t dims[3],
+                             size_t voxel_bytes, size_t swap_width, const umbra__box *box);
+/* umbra_volume_read_box on a NIfTI file (io/nifti.c: any type it loads, converted as it loads
+ * it; .nii.gz inflated as a stream). */
+umbra_status umbra__nifti_read_box(umbra_context ctx, const char *path, const umbra__box *box);
+/* umbra_volume_read_box on a headerless raw file. */
+umbra_status umbra__box_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
+                                 const umbra__box *box);
+
 /* The readers with detached data, with options (checked, or NULL); the public loaders call them
- * with NULL. Messages name the public reader (umbra_volume_load_nrrd, ...). */
+ * with NULL. Messages name the public reader (umbra_volume_load_nrrd, ...). With a box (else
+ * NULL) they read that box of the file (umbra_volume_read_box) and make no volume (out unused). */
 umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
-                                     const umbra_volume_load_options *options, umbra_volume *out);
+                                     const umbra_volume_load_options *options,
+                                     const umbra__box *box, umbra_volume *out);
 umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
                                           const umbra_volume_load_options *options,
-                                          umbra_volume *out);
+                                          const umbra__box *box, umbra_volume *out);
 umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
-                                    const umbra_volume_load_options *options, umbra_volume *out);
+                                    const umbra_volume_load_options *options,
+                                    const umbra__box *box, umbra_volume *out);
 
 /* Reads exactly size bytes of f (which is path) into dst, or fails naming how many came. */
 umbra_status umbra__file_read(umbra_context ctx, const char *func, const char *path, FILE *f,

@@ -617,12 +617,12 @@ done:
 
 umbra_status umbra_volume_load_metaimage(umbra_context ctx, const char *path, umbra_volume *out)
 {
-    return umbra__volume_load_metaimage(ctx, path, NULL, out);
+    return umbra__volume_load_metaimage(ctx, path, NULL, NULL, out);
 }
 
 umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
                                           const umbra_volume_load_options *options,
-                                          umbra_volume *out)
+                                          const umbra__box *box, umbra_volume *out)
 {
     static const char *const func = "umbra_volume_load_metaimage";
     umbra_status st = UMBRA_SUCCESS;
@@ -635,10 +635,11 @@ umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
     const char *df_name;
     int local;
 
-    if (!out) {
+    if (!out && !box) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
     }
-    *out = NULL;
+    if (out)
+        *out = NULL;
     if (!ctx) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", func);
     }
@@ -767,7 +768,24 @@ umbra_status umbra__volume_load_metaimage(umbra_context ctx, const char *path,
                          start, local ? path : dpath, umbra__errno_text(errno, buf, sizeof buf));
         goto fail;
     }
-    {
+    if (box) {
+        int keep = m.type == T_UCHAR || m.type == T_USHORT || m.type == T_SHORT ||
+                   m.type == T_FLOAT;
+        int swap = type_size > 1 && (m.msb != 0) != umbra__host_is_big_endian();
+        st = umbra__box_info(ctx, func, box, met_types[m.type].umbra, m.dims, m.spacing,
+                             m.placed ? m.origin : NULL, m.placed ? m.dirs : NULL, 1);
+        if (st != UMBRA_SUCCESS || umbra__box_header_only(box))
+            goto fail;
+        if (!keep) {
+            st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                             "%s: \"%s\": a box is read of MET_UCHAR, MET_USHORT, MET_SHORT "
+                             "and MET_FLOAT voxels, not %s (load it whole)",
+                             func, path, met_types[m.type].name);
+            goto fail;
+        }
+        st = umbra__box_read(ctx, func, local ? path : dpath, df, m.compressed ? avail : 0, 0,
+                             m.dims, type_size, swap ? type_size : 0, box);
+    } else {
         met_fill F = {ctx, func, local ? path : dpath, df, m.compressed, avail, m.type,
                       m.count, 0, type_size > 1 && (m.msb != 0) != umbra__host_is_big_endian(),
                       NULL};

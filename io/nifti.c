@@ -646,6 +646,96 @@ umbra_status umbra__nifti_read(umbra_context ctx, const char *func, const char *
     return st;
 }
 
+/* The file's world as the volume's: origin = the last column, index axis a's direction = column
+ * a over its length; 0 when the header places nothing (the box stays centred). */
+static int nifti_placement(const umbra__nifti_volume *nv, float origin[3], float directions[9])
+{
+    for (int r = 0; r < 3; ++r) {
+        origin[r] = (float)nv->index_to_world[r][3];
+        for (int a = 0; a < 3; ++a)
+            directions[3 * a + r] = (float)(nv->index_to_world[r][a] / nv->spacing[a]);
+    }
+    return nv->transform != UMBRA__NIFTI_PIXDIM;
+}
+
+umbra_status umbra__nifti_read_box(umbra_context ctx, const char *path, const umbra__box *box)
+{
+    const char *func = "umbra_volume_read_box";
+    umbra__nifti_volume nv;
+    nifti_fill F;
+    float origin[3], directions[9];
+    unsigned char *row = NULL, *dst = NULL;
+    umbra_status st = nifti_header(ctx, func, path, &nv, &F);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    int placed = nifti_placement(&nv, origin, directions);
+    st = umbra__box_info(ctx, func, box, nv.type, nv.dims, nv.spacing, placed ? origin : NULL,
+                         placed ? directions : NULL, 1);
+    if (st != UMBRA_SUCCESS || umbra__box_header_only(box))
+        goto done;
+    {
+        const umbra_volume_box_desc *d = box->desc;
+        const size_t in_size = (size_t)F.nbyper, out_size = umbra_scalar_type_size(F.type);
+        const size_t n = d->size[0], rows = (size_t)d->size[1] * d->size[2];
+        double bad_value = 0.0;
+        int finite = 1;
+        const int keep = !F.scale && ((F.datatype == DT_UINT8 && F.type == UMBRA_UINT8) ||
+                                      (F.datatype == DT_UINT16 && F.type == UMBRA_UINT16) ||
+                                      (F.datatype == DT_INT16 && F.type == UMBRA_INT16) ||
+                                      (F.datatype == DT_FLOAT32 && F.type == UMBRA_FLOAT32));
+        row = malloc(n * in_size);
+        dst = malloc(n * rows * out_size);
+        if (!row || !dst) {
+            st = umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "%s: cannot allocate a box of %zu voxels of \"%s\"", func, n * rows,
+                             path);
+            goto done;
+        }
+        /* Rows in file order, so gzseek only moves forward (inflating what lies between). */
+        for (size_t r = 0; r < rows; ++r) {
+            uint64_t y = d->origin[1] + r % d->size[1], z = d->origin[2] + r / d->size[1];
+            uint64_t at = (uint64_t)F.vox_offset +
+                          ((z * nv.dims[1] + y) * nv.dims[0] + d->origin[0]) * in_size;
+            if (gzseek(F.gz, (z_off_t)at, SEEK_SET) != (z_off_t)at || !read_exactly(&F, row,
+                                                                                 n * in_size)) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: \"%s\": cannot read its %zu bytes of voxels (truncated or "
+                                 "corrupt data)",
+                                 func, path, F.data_bytes);
+                goto done;
+            }
+            if (F.swap)
+                umbra__swap_bytes(row, n, in_size);
+            if (keep) {
+                memcpy(dst + r * n * out_size, row, n * in_size);
+                for (size_t i = 0; F.datatype == DT_FLOAT32 && i < n && finite; ++i) {
+                    float v = ((const float *)row)[i];
+                    if (!isfinite(v)) {
+                        finite = 0;
+                        bad_value = v;
+                    }
+                }
+            }
+            if (keep ? !finite : convert(row, F.datatype, n, F.scale, F.slope, F.inter, F.type,
+                                      dst + r * n * out_size, &bad_value) < n) {
+                st = umbra__fail(ctx, UMBRA_ERROR_FORMAT,
+                                 "%s: \"%s\": a voxel of row y %llu, z %llu is %g: not a finite "
+                                 "float32; voxels must be finite",
+                                 func, path, (unsigned long long)y, (unsigned long long)z,
+                                 bad_value);
+                goto done;
+            }
+        }
+        *box->voxels = dst;
+        dst = NULL;
+    }
+done:
+    free(row);
+    free(dst);
+    nifti_fill_close(&F);
+    return st;
+}
+
 umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path, umbra_volume *out)
 {
     umbra__nifti_volume nv;
@@ -664,18 +754,12 @@ umbra_status umbra_volume_load_nifti(umbra_context ctx, const char *path, umbra_
     if (st != UMBRA_SUCCESS) {
         return st;
     }
-    /* The file's world (RAS+ by NIfTI's convention) becomes the volume's: origin = the last
-     * column, index axis a's direction = column a over its length. A header with neither sform
-     * nor qform places nothing, and the box stays centred. */
-    for (int r = 0; r < 3; ++r) {
-        origin[r] = (float)nv.index_to_world[r][3];
-        for (int a = 0; a < 3; ++a)
-            directions[3 * a + r] = (float)(nv.index_to_world[r][a] / nv.spacing[a]);
-    }
+    /* The file's world (RAS+ by NIfTI's convention) becomes the volume's. A header with
+     * neither sform nor qform places nothing, and the box stays centred. */
+    int placed = nifti_placement(&nv, origin, directions);
     /* The voxels go straight into the volume's buffer (umbra_volume_create_filled). */
     st = umbra__volume_from_fill(ctx, fill_nifti, &F, nv.type, nv.dims, nv.spacing,
-                                 nv.transform != UMBRA__NIFTI_PIXDIM ? origin : NULL,
-                                 nv.transform != UMBRA__NIFTI_PIXDIM ? directions : NULL, out);
+                                 placed ? origin : NULL, placed ? directions : NULL, out);
     nifti_fill_close(&F);
     return st;
 }

@@ -524,11 +524,12 @@ fail:
 
 umbra_status umbra_volume_load_nrrd(umbra_context ctx, const char *path, umbra_volume *out)
 {
-    return umbra__volume_load_nrrd(ctx, path, NULL, out);
+    return umbra__volume_load_nrrd(ctx, path, NULL, NULL, out);
 }
 
 umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
-                                     const umbra_volume_load_options *options, umbra_volume *out)
+                                     const umbra_volume_load_options *options,
+                                     const umbra__box *box, umbra_volume *out)
 {
     static const char *const enc_names[] = {"raw", "gzip", "zrl", "ascii", "hex"};
     const char *func = "umbra_volume_load_nrrd";
@@ -550,10 +551,11 @@ umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
     locale_t c_locale, previous = (locale_t)0;
 
     memset(&h, 0, sizeof h);
-    if (!out) {
+    if (!out && !box) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
     }
-    *out = NULL;
+    if (out)
+        *out = NULL;
     if (!ctx) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", func);
     }
@@ -809,8 +811,24 @@ umbra_status umbra__volume_load_nrrd(umbra_context ctx, const char *path,
         goto fail;
     }
 
-    /* 6. Read and decode, into the device's buffer (fill_nrrd). */
-    {
+    /* 6. Read and decode, into the device's buffer (fill_nrrd), or only a box of it. */
+    if (box) {
+        int swap = type_size > 1 && enc != ENC_ASCII &&
+                   (endian == airEndianBig) != (umbra__host_is_big_endian() != 0);
+        st = umbra__box_info(ctx, func, box, type, dims, spacing, placed ? origin : NULL,
+                             placed ? directions : NULL, 1);
+        if (st != UMBRA_SUCCESS || umbra__box_header_only(box))
+            goto fail;
+        if (enc != ENC_RAW && enc != ENC_GZIP) {
+            st = umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                             "%s: \"%s\": a box is read from raw or gzip data, not %s", func,
+                             path, enc_names[enc]);
+            goto fail;
+        }
+        st = umbra__box_read(ctx, func, data_name, df, enc == ENC_GZIP ? remaining : 0,
+                             enc == ENC_GZIP ? (size_t)byte_skip : 0, dims, type_size,
+                             swap ? type_size : 0, box);
+    } else {
         nrrd_fill F = {ctx, func, data_name, df, enc, remaining, (size_t)byte_skip, count,
                        type_size, type,
                        type_size > 1 && enc != ENC_ASCII &&

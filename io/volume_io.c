@@ -325,7 +325,8 @@ umbra_status umbra__volume_from_fill_kind(umbra_context ctx, umbra_volume_fill_f
  * (umbra_volume_create_filled): no host copy of the voxels. f, when not NULL, is path already
  * opened (of file_size bytes), and is closed here either way. */
 static umbra_status load_raw(umbra_context ctx, const char *func, const char *path, FILE *f,
-                             size_t file_size, const umbra_raw_desc *desc, umbra_volume *out)
+                             size_t file_size, const umbra_raw_desc *desc, const umbra__box *box,
+                             umbra_volume *out)
 {
     umbra_status st = UMBRA_SUCCESS;
     size_t type_size, count, data_bytes, expected;
@@ -403,6 +404,15 @@ static umbra_status load_raw(umbra_context ctx, const char *func, const char *pa
     }
     raw_fill rf = {ctx, func, path, f, count, type_size,
                    type_size > 1 && (desc->big_endian != 0) != umbra__host_is_big_endian()};
+    if (box) {
+        st = umbra__box_info(ctx, func, box, desc->type, desc->dims, desc->spacing, NULL, NULL,
+                             desc->channels);
+        if (st == UMBRA_SUCCESS && !umbra__box_header_only(box)) {
+            st = umbra__box_read(ctx, func, path, f, 0, 0, desc->dims,
+                                 type_size * desc->channels, rf.swap ? type_size : 0, box);
+        }
+        goto fail;
+    }
     st = umbra__volume_from_fill_kind(ctx, fill_raw, &rf, desc->type, desc->dims, desc->spacing,
                                       NULL, NULL, desc->channels, desc->labels, out);
 
@@ -413,33 +423,48 @@ fail:
     return st;
 }
 
-umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
-                                   umbra_volume *out)
+/* umbra_volume_load_raw, or with a box (out unused) umbra_volume_read_box on a raw file. */
+static umbra_status raw_checked(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
+                                const umbra__box *box, umbra_volume *out)
 {
-    if (!out) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", __func__);
+    const char *func = box ? "umbra_volume_read_box" : "umbra_volume_load_raw";
+    if (!out && !box) {
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
     }
-    *out = NULL;
+    if (out)
+        *out = NULL;
     if (!ctx) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", __func__);
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", func);
     }
     if (!path) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", __func__);
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: path is NULL", func);
     }
     if (!desc) {
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", __func__);
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: desc is NULL", func);
     }
     if (desc->struct_size != sizeof(umbra_raw_desc) &&
         desc->struct_size != offsetof(umbra_raw_desc, channels)) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: desc->struct_size is %zu, expected %zu (call umbra_raw_desc_init)",
-                           __func__, desc->struct_size, sizeof(umbra_raw_desc));
+                           func, desc->struct_size, sizeof(umbra_raw_desc));
     }
     umbra_raw_desc d;
     umbra_raw_desc_init(&d);
     memcpy(&d, desc, desc->struct_size);
     d.struct_size = sizeof d;
-    return load_raw(ctx, __func__, path, NULL, 0, &d, out);
+    return load_raw(ctx, func, path, NULL, 0, &d, box, out);
+}
+
+umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
+                                   umbra_volume *out)
+{
+    return raw_checked(ctx, path, desc, NULL, out);
+}
+
+umbra_status umbra__box_load_raw(umbra_context ctx, const char *path, const umbra_raw_desc *desc,
+                                 const umbra__box *box)
+{
+    return raw_checked(ctx, path, desc, box, NULL);
 }
 
 /* ---- Voreen .dat ------------------------------------------------------------------------ */
@@ -482,11 +507,12 @@ static int parse_numbers(const char *s, int n, int ints, uint64_t *u, float *f)
 
 umbra_status umbra_volume_load_dat(umbra_context ctx, const char *path, umbra_volume *out)
 {
-    return umbra__volume_load_dat(ctx, path, NULL, out);
+    return umbra__volume_load_dat(ctx, path, NULL, NULL, out);
 }
 
 umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
-                                    const umbra_volume_load_options *options, umbra_volume *out)
+                                    const umbra_volume_load_options *options,
+                                    const umbra__box *box, umbra_volume *out)
 {
     static const char *const func = "umbra_volume_load_dat";
     umbra_status st = UMBRA_SUCCESS;
@@ -500,10 +526,11 @@ umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
     locale_switch loc;
     int ok, i;
 
-    if (!out) {
+    if (!out && !box) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: out is NULL", func);
     }
-    *out = NULL;
+    if (out)
+        *out = NULL;
     if (!ctx) {
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: ctx is NULL", func);
     }
@@ -622,7 +649,7 @@ umbra_status umbra__volume_load_dat(umbra_context ctx, const char *path,
     if (st != UMBRA_SUCCESS) {
         goto fail;
     }
-    st = load_raw(ctx, func, raw_path, raw_file, raw_size, &raw, out);
+    st = load_raw(ctx, func, raw_path, raw_file, raw_size, &raw, box, out);
 
 fail:
     free(raw_path);

@@ -167,6 +167,49 @@ UMBRA_API void umbra_raw_desc_init(umbra_raw_desc *desc);
 UMBRA_API umbra_status umbra_volume_load_raw(umbra_context ctx, const char *path,
                                              const umbra_raw_desc *desc, umbra_volume *out);
 
+/* ---- a sub-box of a volume file ---------------------------------------------------------------
+ * For a program that holds only a part of a volume in memory (umbra_mpi: each rank its part): the
+ * file's header alone, or the voxels of one box of its grid, read row by row (a raw file is read
+ * at the box's rows only; gzip or zlib data is inflated as a stream and kept at the box's rows
+ * only), never the whole volume in memory. */
+
+/* What a volume file's header declares (umbra_volume_read_box). */
+typedef struct umbra_volume_file_info {
+    size_t struct_size;      /* sizeof(umbra_volume_file_info); set by umbra_volume_read_box */
+    umbra_scalar_type type;  /* the voxels' type as umbra keeps them */
+    uint32_t dims[3];
+    float spacing[3];
+    int transform_given;     /* nonzero: the file places the volume (origin, directions) */
+    float origin[3];
+    float directions[9];
+    uint32_t channels;       /* values per voxel (1, or a raw file's channels) */
+} umbra_volume_file_info;
+
+typedef struct umbra_volume_box_desc {
+    size_t struct_size;      /* sizeof(umbra_volume_box_desc); set by umbra_volume_box_desc_init */
+    uint32_t origin[3];      /* the box's first voxel (default 0) */
+    uint32_t size[3];        /* its voxels per axis, origin + size <= dims; all 0 (default): the
+                                header only, no voxels */
+    const umbra_raw_desc *raw; /* not NULL: path is a headerless raw file so described (borrowed
+                                for the call); NULL (default): the format follows the extension */
+    const umbra_volume_load_options *options; /* the data-file policy (NULL: the defaults) */
+} umbra_volume_box_desc;
+
+/* Fills desc with the defaults (struct_size included); NULL is a no-op. */
+UMBRA_API void umbra_volume_box_desc_init(umbra_volume_box_desc *desc);
+
+/* Reads the header of the volume file path (NRRD .nrrd / .nhdr with raw or gzip encoding; NIfTI
+ * .nii / .nii.gz, converted as umbra_volume_load_nifti converts; MetaImage .mha / .mhd, raw or
+ * compressed, of the types kept as they are (MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT); Voreen
+ * .dat; or a raw file described by desc->raw) into *info and, when desc->size is not all 0, the
+ * voxels of the box desc->origin + [0, desc->size) into a malloc'ed *voxels (x fastest, channels
+ * interleaved, in info->type, the host's byte order; the caller frees it with free()). The file's
+ * size is checked as umbra_volume_load does. A box outside the grid is UMBRA_ERROR_INVALID_ARGUMENT
+ * naming it; other encodings and formats are UMBRA_ERROR_UNSUPPORTED. */
+UMBRA_API umbra_status umbra_volume_read_box(umbra_context ctx, const char *path,
+                                             const umbra_volume_box_desc *desc,
+                                             umbra_volume_file_info *info, void **voxels);
+
 /* ---- transfer functions ---------------------------------------------------------------------- */
 
 /* Reads the text format documented in docs/usage.md (and io/tf_file.c): '#' comments, optional
