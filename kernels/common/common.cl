@@ -373,6 +373,14 @@ UMBRA_INLINE void walk_skip_brick(CellWalk *w, VolGeom g)
     w->t_in = t;
 }
 
+/* Whether the walk's current cell is visible in the per-brick cell masks. */
+UMBRA_INLINE int walk_cell_visible(const CellWalk *w, VolGeom g, __global const ulong *cells)
+{
+    const ulong mask = cells[(w->brick.z * g.bricks.y + w->brick.y) * g.bricks.x + w->brick.x];
+    const int bit = (w->cell.z * UMBRA_BRICK_CELLS + w->cell.y) * UMBRA_BRICK_CELLS + w->cell.x;
+    return (int)((mask >> bit) & 1UL);
+}
+
 /* Walks on to the first cell that the ray leaves after t and that is visible in the per-brick
  * cell masks (a brick the transfer function leaves empty has none), and returns where the ray
  * entered it: at most t if t lies in it, UMBRA_INF if no such cell begins before t_end. */
@@ -420,8 +428,24 @@ UMBRA_INLINE int walk_next_sample(CellWalk *w, VolGeom g, __global const ulong *
             if (!(t < walk_exit(w)))
                 continue; /* the visible cell holds no sample: walk on from t */
         }
-        *t_cell = walk_exit(w);
-        return k;
+        /* A run of visible cells is taken as one: the walk moves on while the next cell is
+         * visible too, so that the samples of the run need no test (the same samples: each lies
+         * in a visible cell of the run, and t_cell, the run's end, is the exit of its last
+         * cell, the same float). It stops in the first invisible cell after the run (where the
+         * next test begins, as it would have begun in that cell), or in the last visible cell
+         * if the ray ends in it. */
+        for (;;) {
+            const float t_out = walk_exit(w);
+            if (!(t_out < t_end)) {
+                *t_cell = t_out;
+                return k;
+            }
+            walk_advance(w, g);
+            if (!walk_cell_visible(w, g, cells)) {
+                *t_cell = w->t_in;
+                return k;
+            }
+        }
     }
 }
 

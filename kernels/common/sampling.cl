@@ -242,11 +242,13 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     i0.z -= s * UMBRA_SLAB_STEP;
     i1.z -= s * UMBRA_SLAB_STEP;
 #endif
-    size_t sy = (size_t)PART_DIMS.x, sz = (size_t)PART_DIMS.x * (size_t)PART_DIMS.y;
-    size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
-    size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
-    float2 c0 = voxel_load2(v, g, z0 + y0 + i0.x), c1 = voxel_load2(v, g, z0 + y1 + i0.x);
-    float2 c2 = voxel_load2(v, g, z1 + y0 + i0.x), c3 = voxel_load2(v, g, z1 + y1 + i0.x);
+    /* The first corner's index and the steps to the others (0 where the cell repeats the
+     * border voxel): one index product instead of four. */
+    const size_t sy = (size_t)PART_DIMS.x, sz = (size_t)PART_DIMS.x * (size_t)PART_DIMS.y;
+    const size_t b = (size_t)i0.z * sz + (size_t)i0.y * sy + (size_t)i0.x;
+    const size_t oy = (size_t)(i1.y - i0.y) * sy, oz = (size_t)(i1.z - i0.z) * sz;
+    float2 c0 = voxel_load2(v, g, b), c1 = voxel_load2(v, g, b + oy);
+    float2 c2 = voxel_load2(v, g, b + oz), c3 = voxel_load2(v, g, b + oz + oy);
     float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
     float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
     return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);

@@ -310,6 +310,23 @@ static float walk_to_visible(const prep *P, walk *w, float t, float t_end)
     }
 }
 
+/* The end of the run of visible cells that begins with the walk's current (visible) cell: the
+ * walk moves on while the next cell is visible too and stops in the first invisible one, or in
+ * the last visible one where the ray ends before t_end (the kernels' walk_next_sample). */
+static float walk_run_end(const prep *P, walk *w, float t_end)
+{
+    for (;;) {
+        float t_out = walk_exit(w);
+        if (!(t_out < t_end))
+            return t_out;
+        walk_advance(P, w);
+        uint64_t mask = P->view_cells[(w->b[2] * P->nb[1] + w->b[1]) * P->nb[0] + w->b[0]];
+        int bit = (w->c[2] * CELLS + w->c[1]) * CELLS + w->c[0];
+        if (!((mask >> bit) & 1u))
+            return w->t_in;
+    }
+}
+
 /* The integral over a table interval (table units) between the entries e0 and e1 (RGBA) of the
  * extinction -ln(1 - a) times 1 - t_c (c = r, g, b) and times 1 (grey), a and t linear between
  * them, a at most 1 - 2^-24 (clamped at the entries): in double, from the substitution
@@ -966,7 +983,7 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                         if (!(t < walk_exit(&w)))
                             continue;
                     }
-                    t_cell = walk_exit(&w);
+                    t_cell = walk_run_end(P, &w, t1);
                 }
                 v3 p = add(org, mul(d, t));
                 ++taken;
