@@ -254,10 +254,14 @@ static void test_interaction_draft_parameters(void **state)
     const umbra__technique *cssm = umbra__technique_by_id(UMBRA_SHADOW_CSSM);
     umbra_shadow_desc d = shadow_of(UMBRA_SHADOW_DEEP), out;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 1);
-    assert_true(out.map.texels_per_voxel == 1.0f);
+    assert_true(out.map.texels_per_voxel == 0.5f);
+    assert_true(out.map.step == 1.0f); /* the technique's own, 0.5, coarsened */
+    assert_true(out.deep.epsilon == 0.06f);
     assert_int_equal(out.map.size, UMBRA_MAP_SIZE_AUTO);
     /* An application's coarser setting is kept. */
-    d.map.texels_per_voxel = 0.5f;
+    d.map.texels_per_voxel = 0.25f;
+    d.map.step = 2.0f;
+    d.deep.epsilon = 0.1f;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 0);
     assert_memory_equal(&out, &d, sizeof d);
     /* A fixed size: scaled by the draft's texels per voxel over the technique's own, rounded
@@ -265,7 +269,7 @@ static void test_interaction_draft_parameters(void **state)
     d = shadow_of(UMBRA_SHADOW_DEEP);
     d.map.size = 1024;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 1);
-    assert_int_equal(out.map.size, 512);
+    assert_int_equal(out.map.size, 256);
     assert_true(out.map.texels_per_voxel == 0.0f);
     d = shadow_of(UMBRA_SHADOW_CSSM);
     d.map.size = 1024;
