@@ -7,8 +7,9 @@
  *  - the first frame, queries, techniques without a draft and UMBRA_INTERACTION_OFF use the full
  *    structure; a view transfer-function change under a separate light one is no change;
  *  - the draft's parameters: the map's texels per voxel (auto sizes; the deep map's light step
- *    and epsilon too), a fixed size scaled and bounded, a coarser application setting kept; every registered draft applies, and the
- *    accuracy sweep's draft row of each technique (label "..., draft") is that draft;
+ *    and epsilon too), a fixed size scaled and bounded, a coarser application setting kept;
+ *    every registered draft applies, and the accuracy sweep's draft row of each technique
+ *    (label "..., draft") is that draft;
  *  - set_options refuses an unknown interaction and accepts umbra 0.5.0's layout. */
 #include <math.h>
 #include <stdlib.h>
