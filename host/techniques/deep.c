@@ -595,10 +595,10 @@ const umbra__technique umbra__technique_deep = {
          * halve the error of one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
         .map_texels_per_voxel = 2.0f,
         .map_step = 0.5f, /* lightspace.h: its nodes follow the sampled visibility */
-        /* While the light moves (interaction auto): a quarter of the texels, a step of one voxel
-         * and epsilon 0.06 (the deep-shadow paper's "lower resolution and higher error bound
-         * during interaction"); the build is then a small part of the frame, whose cost is the
-         * lookups (docs/performance.md, 2026-12-02). */
+        /* While the light moves (interaction auto): half a texel per voxel (a sixteenth of the
+         * full map's texels), a step of one voxel and epsilon 0.06 (the deep-shadow paper's
+         * "lower resolution and higher error bound during interaction"); the build is then a
+         * small part of the frame, whose cost is the lookups (docs/performance.md, 2026-12-02). */
         .draft = "map_texels_per_voxel<=0.5;map_step>=1;epsilon>=0.06",
     },
     .params = params,
