@@ -702,6 +702,22 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
     assert_int_equal(b.builds, 5);
     assert_int_equal(b.lut_builds, 1);
 
+    /* Another step (a draft's) builds a second table and keeps the first: back and forth
+     * between the two builds no table again, and both are counted in the memory. */
+    const size_t one_table = b.lut_bytes;
+    float full_img[32 * 32 * 4];
+    assert_int_equal(umbra_renderer_render(r, 32, 32, full_img), UMBRA_SUCCESS);
+    for (int pass = 0; pass < 2; ++pass) {
+        set_shadow(r, deep_desc(64, 1.0f, 0.06f, 1, 1, 0));
+        assert_int_equal(umbra_renderer_render(r, 32, 32, img), UMBRA_SUCCESS);
+        set_shadow(r, deep_desc(64, 0.5f, 0.06f, 1, 1, 0));
+        assert_int_equal(umbra_renderer_render(r, 32, 32, img), UMBRA_SUCCESS);
+        assert_memory_equal(img, full_img, sizeof img); /* the table the step asks for */
+    }
+    assert_int_equal(umbra__deep_get_info(r, &b), UMBRA_SUCCESS);
+    assert_int_equal(b.lut_builds, 2);
+    assert_int_equal(b.lut_bytes, 2 * one_table);
+
     /* A grey light transfer function: one channel, 8-byte nodes, a new table (its key holds
      * the channel count and the table's id). */
     umbra_transfer_function grey = test_constant_tf(ctx, 0.5f, 0.05f);
@@ -712,7 +728,8 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
     assert_int_equal(umbra__deep_get_info(r, &b), UMBRA_SUCCESS);
     assert_int_equal(b.channels, 1);
     assert_int_equal(b.node_bytes, 8);
-    assert_int_equal(b.lut_builds, 2);
+    assert_int_equal(b.lut_builds, 3);
+    assert_int_equal(b.lut_bytes, one_table / 2); /* the other transfer function's are gone */
     umbra_transfer_function_release(grey);
     umbra_renderer_release(r);
     umbra_scene_release(&sc);

@@ -6,9 +6,10 @@
  *    changed builds the full structure, bit for bit a fresh full render; a camera move keeps it;
  *  - the first frame, queries, techniques without a draft and UMBRA_INTERACTION_OFF use the full
  *    structure; a view transfer-function change under a separate light one is no change;
- *  - the draft's parameters: the map's texels per voxel (auto sizes), a fixed size scaled and
- *    bounded, a coarser application setting kept; every registered draft applies, and the
- *    accuracy sweep's draft row of each technique (label "..., draft") is that draft;
+ *  - the draft's parameters: the map's texels per voxel (auto sizes; the deep map's light step
+ *    and epsilon too), a fixed size scaled and bounded, a coarser application setting kept;
+ *    every registered draft applies, and the accuracy sweep's draft row of each technique
+ *    (label "..., draft") is that draft;
  *  - set_options refuses an unknown interaction and accepts umbra 0.5.0's layout. */
 #include <math.h>
 #include <stdlib.h>
@@ -254,10 +255,14 @@ static void test_interaction_draft_parameters(void **state)
     const umbra__technique *cssm = umbra__technique_by_id(UMBRA_SHADOW_CSSM);
     umbra_shadow_desc d = shadow_of(UMBRA_SHADOW_DEEP), out;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 1);
-    assert_true(out.map.texels_per_voxel == 1.0f);
+    assert_true(out.map.texels_per_voxel == 0.5f);
+    assert_true(out.map.step == 1.0f); /* the technique's own, 0.5, coarsened */
+    assert_true(out.deep.epsilon == 0.06f);
     assert_int_equal(out.map.size, UMBRA_MAP_SIZE_AUTO);
     /* An application's coarser setting is kept. */
-    d.map.texels_per_voxel = 0.5f;
+    d.map.texels_per_voxel = 0.25f;
+    d.map.step = 2.0f;
+    d.deep.epsilon = 0.1f;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 0);
     assert_memory_equal(&out, &d, sizeof d);
     /* A fixed size: scaled by the draft's texels per voxel over the technique's own, rounded
@@ -265,7 +270,7 @@ static void test_interaction_draft_parameters(void **state)
     d = shadow_of(UMBRA_SHADOW_DEEP);
     d.map.size = 1024;
     assert_int_equal(umbra__draft_desc(deep, &d, &out), 1);
-    assert_int_equal(out.map.size, 512);
+    assert_int_equal(out.map.size, 256);
     assert_true(out.map.texels_per_voxel == 0.0f);
     d = shadow_of(UMBRA_SHADOW_CSSM);
     d.map.size = 1024;

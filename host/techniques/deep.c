@@ -4,7 +4,9 @@
  *
  *   - the pre-compressed segment table (256 x 256 entries of 4 nodes), cached by what it depends
  *     on -- the light transfer function, the light step, the number of light channels and the
- *     transmission mode -- so a light move or a camera move never rebuilds it;
+ *     transmission mode -- so a light move or a camera move never rebuilds it; two are kept
+ *     where they differ only in the step (the draft's and the full map's, which interaction
+ *     auto alternates between), so neither a draft nor the full map after it rebuilds one;
  *   - the blocked map: a pool of blocks (K node layers of one tile each), a head index per tile,
  *     a next index per block and a node count per texel. The pool is sized from the last build
  *     (or two blocks per tile the first time); a build that asks for more blocks than the pool
@@ -34,9 +36,9 @@ typedef struct deep_state {
     cl_kernel k_lut, k_build, k_fixed;
     uint32_t tile;                  /* chosen for k_build's work-group limit */
 
-    cl_mem lut;
-    uint64_t lut_key[4];            /* (light tf id, light step bits, channels, colored) */
-    int lut_valid;
+    cl_mem lut[2];                  /* the tables held; lut_cur is the one the build uses */
+    uint64_t lut_key[2][4];         /* (light tf id, light step bits, channels, colored) */
+    int lut_valid[2], lut_cur;
 
     UmbraDeep constants;            /* the kernels' UmbraDeep, for the last build */
     cl_mem constants_buf;
@@ -191,7 +193,9 @@ fail:
     return st;
 }
 
-/* The segment table for the current light table, rebuilt only when its key changed. */
+/* The segment table for the current light table, rebuilt only when its key changed. Two slots:
+ * a new key replaces the slot not in use, and a table in the other slot whose key differs in more
+ * than the step (another transfer function, channel count or transmission) is released. */
 static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
 {
     umbra_context ctx = r->ctx;
@@ -201,23 +205,34 @@ static umbra_status ensure_lut(umbra_renderer r, deep_state *s, double *ms)
     memcpy(&step_bits, &step, sizeof step_bits);
     uint64_t key[4] = {umbra__light_tf(r)->id, step_bits, r->channels,
                        r->opts.transmission == UMBRA_TRANSMISSION_COLORED};
-    if (s->lut && s->lut_valid && memcmp(key, s->lut_key, sizeof key) == 0)
-        return UMBRA_SUCCESS;
-    s->lut_valid = 0;
-    release_mem(&s->lut);
+    for (int i = 0; i < 2; ++i)
+        if (s->lut[i] && s->lut_valid[i] && memcmp(key, s->lut_key[i], sizeof key) == 0) {
+            s->lut_cur = i;
+            return UMBRA_SUCCESS;
+        }
+    const int slot = s->lut[s->lut_cur] && s->lut_valid[s->lut_cur] ? 1 - s->lut_cur : s->lut_cur;
+    const int other = 1 - slot;
+    if (s->lut[other] && (!s->lut_valid[other] || s->lut_key[other][0] != key[0] ||
+                          s->lut_key[other][2] != key[2] || s->lut_key[other][3] != key[3])) {
+        release_mem(&s->lut[other]);
+        s->lut_valid[other] = 0;
+    }
+    s->lut_cur = slot;
+    s->lut_valid[slot] = 0;
+    release_mem(&s->lut[slot]);
     size_t bytes = (size_t)UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_NODES *
                    s->node_bytes;
-    if ((st = create_buffer(ctx, bytes, "segment table", &s->lut)) != UMBRA_SUCCESS)
+    if ((st = create_buffer(ctx, bytes, "segment table", &s->lut[slot])) != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clSetKernelArg(s->k_lut, 0, sizeof(cl_mem), &r->frame_buf));
     UMBRA_CL(clSetKernelArg(s->k_lut, 1, sizeof(cl_mem), &r->light_tf_buf));
-    UMBRA_CL(clSetKernelArg(s->k_lut, 2, sizeof(cl_mem), &s->lut));
+    UMBRA_CL(clSetKernelArg(s->k_lut, 2, sizeof(cl_mem), &s->lut[slot]));
     UMBRA_CL(clSetKernelArg(s->k_lut, 3, sizeof step, &step)); /* the segment, in voxels */
     size_t global[2] = {UMBRA__DEEP_LUT_RES, UMBRA__DEEP_LUT_RES};
     if ((st = run_kernel(r, s->k_lut, global, NULL, ms)) != UMBRA_SUCCESS)
         goto fail;
-    memcpy(s->lut_key, key, sizeof key);
-    s->lut_valid = 1;
+    memcpy(s->lut_key[slot], key, sizeof key);
+    s->lut_valid[slot] = 1;
     s->lut_builds++;
 fail:
     return st;
@@ -233,7 +248,7 @@ static umbra_status bind_march(umbra_renderer r, deep_state *s, cl_kernel k, cl_
         return st;
     cl_uint use_lut = s->lut_used ? 1u : 0u;
     float eps = r->shadow.deep.epsilon;
-    cl_mem lut = s->lut_used ? s->lut : s->dummy;
+    cl_mem lut = s->lut_used ? s->lut[s->lut_cur] : s->dummy;
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &s->constants_buf));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof(cl_mem), &lut));
     UMBRA_CL(clSetKernelArg(k, (*next)++, sizeof use_lut, &use_lut));
@@ -441,11 +456,14 @@ fail:
     return st;
 }
 
+/* The tables held (one, or the draft's and the full map's). */
 static size_t lut_bytes(const deep_state *s)
 {
-    return s->lut_used && s->lut ? (size_t)UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_RES *
-                                       UMBRA__DEEP_LUT_NODES * s->node_bytes
-                                 : 0;
+    if (!s->lut_used)
+        return 0;
+    const size_t one =
+        (size_t)UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_RES * UMBRA__DEEP_LUT_NODES * s->node_bytes;
+    return one * (size_t)((s->lut[0] != NULL) + (s->lut[1] != NULL));
 }
 
 static size_t map_bytes(const deep_state *s)
@@ -477,8 +495,8 @@ static void deep_destroy(umbra_renderer r)
     release_kernel(&s->k_lut);
     release_kernel(&s->k_build);
     release_kernel(&s->k_fixed);
-    cl_mem *mems[] = {&s->lut, &s->pool, &s->next, &s->head, &s->counts, &s->counter, &s->fixed,
-                      &s->dummy, &s->constants_buf};
+    cl_mem *mems[] = {&s->lut[0], &s->lut[1], &s->pool,  &s->next,  &s->head,
+                      &s->counts, &s->counter, &s->fixed, &s->dummy, &s->constants_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         release_mem(mems[i]);
     free(s);
@@ -521,8 +539,8 @@ static const umbra__setting sweep[] = {
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL | UMBRA__SWEEP_HEADLINE},
     {"map_size=2048;epsilon=0.02;max_nodes=0;prefilter=1", "2048², ε 0.02",
      UMBRA__SWEEP_PAPERS_CSSM},
-    {"map_size=auto;epsilon=0.02;max_nodes=0;prefilter=1;map_texels_per_voxel=1",
-     "auto size, ε 0.02, draft",
+    {"map_size=auto;epsilon=0.06;max_nodes=0;prefilter=1;map_texels_per_voxel=0.5;map_step=1",
+     "auto size, ε 0.06, step 1, draft",
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL},
     {"map_size=512;epsilon=0.02;max_nodes=3;prefilter=1", "512², ε 0.02, 3 nodes",
      UMBRA__SWEEP_QUICK | UMBRA__SWEEP_HEADLINE_QUICK},
@@ -577,7 +595,11 @@ const umbra__technique umbra__technique_deep = {
          * halve the error of one (walnut: 0.0018 to 0.0010) for under half the rays of three. */
         .map_texels_per_voxel = 2.0f,
         .map_step = 0.5f, /* lightspace.h: its nodes follow the sampled visibility */
-        .draft = "map_texels_per_voxel<=1",
+        /* While the light moves (interaction auto): half a texel per voxel (a sixteenth of the
+         * full map's texels), a step of one voxel and epsilon 0.06 (the deep-shadow paper's
+         * "lower resolution and higher error bound during interaction"); the build is then a
+         * small part of the frame, whose cost is the lookups (docs/performance.md, 2026-12-02). */
+        .draft = "map_texels_per_voxel<=0.5;map_step>=1;epsilon>=0.06",
     },
     .params = params,
     .sweep = sweep,
