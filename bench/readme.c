@@ -18,7 +18,9 @@
  *             plots;
  *   gallery   the main scene's pictures from the same run (DIR/images/SCENE/, written by
  *             `--images headline`), one table row each with the build time, render time, memory,
- *             light channels and error read from accuracy.csv.
+ *             light channels and error read from accuracy.csv;
+ *   texel     DIR/texel.md (`texel SUB`: DIR/SUB/texel.md), every scene's plot of RMSE against
+ *             bytes per map texel, its Pareto front and the moment map at equal memory.
  * Links are written relative to each file's folder. `--check` changes nothing and exits 1 when a
  * file is out of date (for a pre-commit check and the docs_check test). */
 #define _XOPEN_SOURCE 700
@@ -208,6 +210,32 @@ static int block_headline(const job *J, text *out)
     return rc;
 }
 
+/* DIR/SUB/texel.md (SUB the block's argument, else DIR itself): the maps' error against bytes
+ * per texel, with its links made relative to the file. */
+static int block_texel(const job *J, const char *sub, text *out)
+{
+    char path[PATH_MAX + 300], link[PATH_MAX + 300];
+    snprintf(path, sizeof path, "%s%s%s/texel.md", J->results, *sub ? "/" : "", sub);
+    snprintf(link, sizeof link, "%s%s%s/", J->link, *sub ? "/" : "", sub);
+    char *md = read_file(path);
+    if (!md) {
+        fprintf(stderr, "readme: cannot read %s: %s (run `umbra-bench accuracy` first)\n", path,
+                strerror(errno));
+        return -1;
+    }
+    text t = {0};
+    int rc = add_lines(&t, md);
+    free(md);
+    for (const char *p = t.s; rc == 0 && p && *p;) {
+        const char *at = strstr(p, "](plots/");
+        const size_t n = at ? (size_t)(at - p) + 2 : strlen(p);
+        rc = text_add(out, p, n) || (at && text_add(out, link, strlen(link)));
+        p += n;
+    }
+    free(t.s);
+    return rc;
+}
+
 /* The headline table's all-scenes part, for the README's choice of a technique. */
 static int block_choose(const job *J, text *out) { return add_headline(J, out, 1); }
 
@@ -309,6 +337,9 @@ static int regenerate(const job *J, const char *src, text *out)
         }
         char block[64];
         snprintf(block, sizeof block, "%.*s", (int)(close - name), name);
+        char *arg = strchr(block, ' '); /* "texel moments": a folder under the results */
+        if (arg)
+            *arg++ = '\0';
         const char *after_open = close + 4;
         if (*after_open == '\n')
             ++after_open;
@@ -321,9 +352,11 @@ static int regenerate(const job *J, const char *src, text *out)
             rc = block_choose(J, out);
         else if (strcmp(block, "gallery") == 0)
             rc = block_gallery(J, out);
+        else if (strcmp(block, "texel") == 0 && (!arg || !strstr(arg, "..")))
+            rc = block_texel(J, arg ? arg : "", out);
         else {
-            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery)\n",
-                    J->readme, block);
+            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery, texel "
+                            "[FOLDER])\n", J->readme, block);
             rc = -1;
         }
         if (rc != 0)
@@ -386,9 +419,9 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
                "[--check]\n"
-               "  rewrites the '" MARK_BEGIN "choose|headline|gallery -->' blocks of README.md,\n"
-               "  docs/accuracy.md and any other docs/*.md holding one, from the results of\n"
-               "  `umbra-bench accuracy`\n"
+               "  rewrites the '" MARK_BEGIN "choose|headline|gallery|texel [SUB] -->' blocks of\n"
+               "  README.md, docs/accuracy.md and any other docs/*.md holding one, from the\n"
+               "  results of `umbra-bench accuracy` (texel: of its folder SUB)\n"
                "  --readme FILE   only this file\n"
                "  --results DIR   default <source>/bench/results/accuracy\n"
                "  --scene NAME    the scene of the plots and pictures (default walnut)\n"
