@@ -19,8 +19,9 @@
  *   gallery   the main scene's pictures from the same run (DIR/images/SCENE/, written by
  *             `--images headline`), one table row each with the build time, render time, memory,
  *             light channels and error read from accuracy.csv;
- *   texel     DIR/texel.md (`texel SUB`: DIR/SUB/texel.md), every scene's plot of RMSE against
- *             bytes per map texel, its Pareto front and the moment map at equal memory.
+ *   texel     DIR/texel.md, every scene's plot of RMSE against bytes per map texel, its Pareto
+ *             front and the moment map at equal memory.
+ * `NAME SUB` takes the block from the results' folder SUB instead (DIR/SUB: a second sweep). 
  * Links are written relative to each file's folder. `--check` changes nothing and exits 1 when a
  * file is out of date (for a pre-commit check and the docs_check test). */
 #define _XOPEN_SOURCE 700
@@ -210,13 +211,12 @@ static int block_headline(const job *J, text *out)
     return rc;
 }
 
-/* DIR/SUB/texel.md (SUB the block's argument, else DIR itself): the maps' error against bytes
- * per texel, with its links made relative to the file. */
-static int block_texel(const job *J, const char *sub, text *out)
+/* DIR/texel.md: the maps' error against bytes per texel, its links made relative to the file. */
+static int block_texel(const job *J, text *out)
 {
-    char path[PATH_MAX + 300], link[PATH_MAX + 300];
-    snprintf(path, sizeof path, "%s%s%s/texel.md", J->results, *sub ? "/" : "", sub);
-    snprintf(link, sizeof link, "%s%s%s/", J->link, *sub ? "/" : "", sub);
+    char path[PATH_MAX + 64], link[PATH_MAX + 8];
+    snprintf(path, sizeof path, "%s/texel.md", J->results);
+    snprintf(link, sizeof link, "%s/", J->link);
     char *md = read_file(path);
     if (!md) {
         fprintf(stderr, "readme: cannot read %s: %s (run `umbra-bench accuracy` first)\n", path,
@@ -337,9 +337,23 @@ static int regenerate(const job *J, const char *src, text *out)
         }
         char block[64];
         snprintf(block, sizeof block, "%.*s", (int)(close - name), name);
-        char *arg = strchr(block, ' '); /* "texel moments": a folder under the results */
-        if (arg)
+        /* "NAME SUB": the block from the results' folder SUB (a folder name, no "..") */
+        job K = *J;
+        char *arg = strchr(block, ' ');
+        if (arg) {
             *arg++ = '\0';
+            const size_t rl = strlen(K.results), ll = strlen(K.link), al = strlen(arg);
+            if (strstr(arg, "..") || strchr(arg, ' ') || rl + al + 2 > sizeof K.results ||
+                ll + al + 2 > sizeof K.link) {
+                fprintf(stderr, "readme: %s: bad folder '%s' in block '%s'\n", J->readme, arg,
+                        block);
+                return -1;
+            }
+            K.results[rl] = '/';
+            memcpy(K.results + rl + 1, arg, al + 1);
+            K.link[ll] = '/';
+            memcpy(K.link + ll + 1, arg, al + 1);
+        }
         const char *after_open = close + 4;
         if (*after_open == '\n')
             ++after_open;
@@ -347,16 +361,16 @@ static int regenerate(const job *J, const char *src, text *out)
             return -1;
         int rc;
         if (strcmp(block, "headline") == 0)
-            rc = block_headline(J, out);
+            rc = block_headline(&K, out);
         else if (strcmp(block, "choose") == 0)
-            rc = block_choose(J, out);
+            rc = block_choose(&K, out);
         else if (strcmp(block, "gallery") == 0)
-            rc = block_gallery(J, out);
-        else if (strcmp(block, "texel") == 0 && (!arg || !strstr(arg, "..")))
-            rc = block_texel(J, arg ? arg : "", out);
+            rc = block_gallery(&K, out);
+        else if (strcmp(block, "texel") == 0)
+            rc = block_texel(&K, out);
         else {
-            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery, texel "
-                            "[FOLDER])\n", J->readme, block);
+            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery, texel)\n",
+                    J->readme, block);
             rc = -1;
         }
         if (rc != 0)
@@ -419,9 +433,10 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
                "[--check]\n"
-               "  rewrites the '" MARK_BEGIN "choose|headline|gallery|texel [SUB] -->' blocks of\n"
-               "  README.md, docs/accuracy.md and any other docs/*.md holding one, from the\n"
-               "  results of `umbra-bench accuracy` (texel: of its folder SUB)\n"
+               "  rewrites the '" MARK_BEGIN "NAME [SUB] -->' blocks (NAME: choose,\n"
+               "  headline, gallery or texel; SUB: a folder of the results) of README.md,\n"
+               "  docs/accuracy.md and any other docs/*.md holding one, from the results of\n"
+               "  `umbra-bench accuracy`\n"
                "  --readme FILE   only this file\n"
                "  --results DIR   default <source>/bench/results/accuracy\n"
                "  --scene NAME    the scene of the plots and pictures (default walnut)\n"
