@@ -271,6 +271,7 @@ static void usage(FILE *f)
         "  --no-cache       render the exact references again (and refresh the cache)\n"
         "  --merge CSV      keep the rows of an earlier accuracy.csv that this run does not\n"
         "                   measure (same scene, technique and params), and report them all\n"
+        "  --report         measure nothing: write the outputs from the --merge rows alone\n"
         "  --no-plots       skip gnuplot\n"
         "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
         "  --main NAME      the scene of the headline's first table (default walnut)\n"
@@ -339,6 +340,8 @@ static int parse_options(int argc, char **argv, options *o)
         } else if (strcmp(a, "--out") == 0 && v) {
             snprintf(o->out, sizeof o->out, "%s", v);
             ++i;
+        } else if (strcmp(a, "--report") == 0) {
+            o->report = 1;
         } else if (strcmp(a, "--merge") == 0 && v) {
             snprintf(o->merge, sizeof o->merge, "%s", v);
             ++i;
@@ -448,8 +451,9 @@ static int load_scenes(bench_run *B)
             rc = -1;
             break;
         }
-        const int selected = B->o.scenes[0] ? in_list(B->o.scenes, stem)
-                                             : !(B->o.quick && !s->quick);
+        const int selected = B->o.report      ? 0
+                             : B->o.scenes[0] ? in_list(B->o.scenes, stem)
+                                              : !(B->o.quick && !s->quick);
         if (!selected && !from_merge)
             continue;
         B->merged_only[B->scene_count] = !selected;
@@ -482,6 +486,10 @@ int bench_accuracy(int argc, char **argv)
     int prc = parse_options(argc, argv, &B.o);
     if (prc != 0)
         return prc > 0 ? 0 : 2;
+    if (B.o.report && !B.o.merge[0]) {
+        fprintf(stderr, "umbra-bench accuracy: --report needs --merge CSV\n");
+        return 2;
+    }
     if (load_scenes(&B) != 0)
         return 2;
 

@@ -108,6 +108,7 @@ typedef struct note_list {
 /* The command line (accuracy.c parse_options). */
 typedef struct options {
     int quick, runs, warmup, plots, list;
+    int report; /* --report: nothing measured, the outputs from the --merge rows */
     int cache; /* read cached references (0: --no-cache); they are written either way */
     const char *images;      /* none | headline | all */
     char out[2048], cache_dir[2100], scene_dir[2048], main_scene[SCENE_NAME_MAX];
