@@ -204,6 +204,9 @@ void accuracy_merge_rows(bench_run *B)
         r->slices = (uint32_t)num(&m, f, n, "slices");
         r->samples = (uint64_t)num(&m, f, n, "samples");
         r->map_size = (uint32_t)num(&m, f, n, "map_size");
+        if (c->desc.map.size == UMBRA_MAP_SIZE_AUTO && r->map_size) /* as accuracy_run.c */
+            snprintf(r->cfg.label + strlen(r->cfg.label),
+                     sizeof r->cfg.label - strlen(r->cfg.label), " (%u²)", r->map_size);
         r->err.rmse = num(&m, f, n, "rmse");
         r->err.psnr_db = num(&m, f, n, "psnr_db");
         r->err.max_abs = num(&m, f, n, "max_abs");

@@ -20,9 +20,7 @@ static int cmp_texel(const void *a, const void *b)
 static void setting(const result *r, char *out, size_t size)
 {
     snprintf(out, size, "%s, %s", umbra_shadow_technique_name(r->cfg.desc.technique),
-             r->cfg.label);
-    if (strncmp(r->cfg.label, "auto", 4) == 0)
-        snprintf(out + strlen(out), size - strlen(out), " (%u²)", r->map_size);
+             r->cfg.label); /* an auto size's label holds the size built: "auto size (192²)" */
 }
 
 /* The moment row of scene si with the lowest RMSE within 1.05 x memory, or NULL. */
@@ -82,7 +80,7 @@ void accuracy_write_texel(bench_run *B)
                "moments are lower.\n\n"
                "| scene | setting | its RMSE | its memory | best moments within it | RMSE | "
                "memory |\n|---|---|---:|---:|---|---:|---:|\n");
-    char against[8][160];
+    char against[8][256];
     int wins[8] = {0}, counted[8] = {0}, kinds = 0;
     for (int si = 0; si < B->scene_count; ++si)
         for (int k = 0; k < B->result_count; ++k) {
