@@ -19,20 +19,14 @@
 
 #include "test_util.h"
 
+/* The group's context (test_group_setup), also used by the helpers below. */
 static umbra_context ctx;
 
 static int setup(void **state)
 {
-    (void)state;
-    ctx = test_context();
-    return ctx ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    umbra_context_release(ctx);
-    return 0;
+    int rc = test_group_setup(state);
+    ctx = *state;
+    return rc;
 }
 
 /* ---- the brute force ----------------------------------------------------------------------- */
@@ -451,5 +445,5 @@ int main(int argc, char **argv)
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, setup, test_group_teardown);
 }
