@@ -15,22 +15,6 @@
 #define MERGE_LINE_MAX 4096
 #define MERGE_FIELDS_MAX 64
 
-/* Splits line (modified) at commas into f; the fields are sanitized, so none holds a comma. */
-static int split_fields(char *line, char **f)
-{
-    int n = 0;
-    line[strcspn(line, "\r\n")] = '\0';
-    for (char *p = line; n < MERGE_FIELDS_MAX;) {
-        f[n++] = p;
-        char *c = strchr(p, ',');
-        if (!c)
-            break;
-        *c = '\0';
-        p = c + 1;
-    }
-    return n;
-}
-
 typedef struct merge_file {
     FILE *f;
     char *head[MERGE_FIELDS_MAX];
@@ -79,7 +63,7 @@ static int merge_open(merge_file *m)
         m->f = NULL;
         return -1;
     }
-    m->head_count = split_fields(m->head_line, m->head);
+    m->head_count = bench_split_csv(m->head_line, m->head, MERGE_FIELDS_MAX);
     return 0;
 }
 
@@ -106,7 +90,7 @@ int accuracy_merge_scene_names(char *names, size_t size)
     names[0] = '\0';
     char line[MERGE_LINE_MAX], *f[MERGE_FIELDS_MAX];
     while (fgets(line, sizeof line, m.f)) {
-        const int n = split_fields(line, f);
+        const int n = bench_split_csv(line, f, MERGE_FIELDS_MAX);
         const char *scene = field(&m, f, n, "scene");
         char key[SCENE_NAME_MAX + 2];
         snprintf(key, sizeof key, ",%s,", scene);
@@ -169,7 +153,7 @@ void accuracy_merge_rows(bench_run *B)
     int kept = 0, unmatched = 0;
     char line[MERGE_LINE_MAX], *f[MERGE_FIELDS_MAX];
     while (fgets(line, sizeof line, m.f)) {
-        const int n = split_fields(line, f);
+        const int n = bench_split_csv(line, f, MERGE_FIELDS_MAX);
         const int si = accuracy_scene_index(B, field(&m, f, n, "scene"));
         if (si < 0)
             continue;

@@ -126,22 +126,6 @@ static void image_name(const char *technique, const char *params, char *out, siz
             *s = '_';
 }
 
-/* Splits a CSV line (no quoting: accuracy.csv has none) in place; returns the field count. */
-static int split_csv(char *line, char **fields, int max)
-{
-    int n = 0;
-    line[strcspn(line, "\r\n")] = '\0';
-    for (char *p = line; n < max;) {
-        fields[n++] = p;
-        char *comma = strchr(p, ',');
-        if (!comma)
-            break;
-        *comma = '\0';
-        p = comma + 1;
-    }
-    return n;
-}
-
 static int column(char **header, int n, const char *name)
 {
     for (int i = 0; i < n; ++i)
@@ -251,9 +235,9 @@ static int block_gallery(const job *J, text *out)
     }
     char header_line[4096], line[4096];
     char *header[MAX_COLUMNS], *v[MAX_COLUMNS];
-    int nh = fgets(header_line, sizeof header_line, f) ? split_csv(header_line, header,
-                                                                    MAX_COLUMNS)
-                                                       : 0;
+    int nh = fgets(header_line, sizeof header_line, f)
+                 ? bench_split_csv(header_line, header, MAX_COLUMNS)
+                 : 0;
     const char *names[] = {"scene",  "technique",    "label",          "params",
                            "width",  "height",       "build_ms",       "render_ms",
                            "memory_bytes", "light_channels", "rmse", "ssim"};
@@ -268,7 +252,7 @@ static int block_gallery(const job *J, text *out)
         }
     int rows = 0, rc = 0;
     while (rc == 0 && fgets(line, sizeof line, f)) {
-        int n = split_csv(line, v, MAX_COLUMNS);
+        int n = bench_split_csv(line, v, MAX_COLUMNS);
         if (n != nh || strcmp(v[col[SCENE]], J->scene) != 0)
             continue;
         char name[512], image[PATH_MAX + 700];
