@@ -84,7 +84,7 @@ void umbra__clip_update(umbra_renderer r)
     /* Voxel i's centre lies at box_min + (i + 0.5) spacing in the local frame; without a crop
      * box the region's box is the volume's. */
     for (int a = 0; a < 3; ++a) {
-        const float half = 0.5f * (float)v->dims[a] * v->spacing[a];
+        const float half = 0.5f * (float)v->grid_dims[a] * v->spacing[a];
         C->box_min[a] = d->crop ? -half + (d->crop_min[a] + 0.5f) * v->spacing[a] : -half;
         C->box_max[a] = d->crop ? -half + (d->crop_max[a] + 0.5f) * v->spacing[a] : half;
     }

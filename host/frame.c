@@ -24,12 +24,12 @@ void umbra__frame_update_light(umbra_renderer r)
     umbra_volume v = r->volume;
     float ext[3];
     for (int a = 0; a < 3; ++a)
-        ext[a] = (float)v->dims[a] * v->spacing[a];
+        ext[a] = (float)v->grid_dims[a] * v->spacing[a];
     set4(F->box_min, -0.5f * ext[0], -0.5f * ext[1], -0.5f * ext[2], 0.0f);
     set4(F->box_max, 0.5f * ext[0], 0.5f * ext[1], 0.5f * ext[2], 0.0f);
     set4(F->inv_spacing, 1.0f / v->spacing[0], 1.0f / v->spacing[1], 1.0f / v->spacing[2], 0.0f);
     for (int a = 0; a < 3; ++a) {
-        F->dims[a] = (int32_t)v->dims[a];
+        F->dims[a] = (int32_t)v->grid_dims[a];
         F->bricks[a] = (int32_t)v->brick_counts[a];
     }
     F->dims[3] = 0;
@@ -64,6 +64,7 @@ void umbra__frame_update_light(umbra_renderer r)
     r->channels = (r->opts.transmission == UMBRA_TRANSMISSION_GREY || umbra__light_tfs_grey(r))
                       ? 1u
                       : 3u;
+    umbra__part_frame(r, 0);
 }
 
 /* Length in double: the squares of floats above 1.8e19 overflow a float (a direction of
@@ -105,7 +106,7 @@ void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     const umbra_render_desc *o = &r->opts;
     float ext[3], diag = 0.0f;
     for (int a = 0; a < 3; ++a) {
-        ext[a] = (float)r->volume->dims[a] * r->volume->spacing[a];
+        ext[a] = (float)r->volume->grid_dims[a] * r->volume->spacing[a];
         diag += ext[a] * ext[a];
     }
     diag = sqrtf(diag);
@@ -156,6 +157,7 @@ void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height)
     F->flags = keep | (o->jitter ? UMBRA_FLAG_JITTER : 0u) | (o->shading ? UMBRA_FLAG_SHADING : 0u) |
                (o->ground_plane ? UMBRA_FLAG_GROUND : 0u) |
                (c.projection == UMBRA_ORTHOGRAPHIC ? UMBRA_FLAG_ORTHO : 0u);
+    umbra__part_frame(r, 1);
 }
 
 umbra_status umbra__ensure_buffer(umbra_renderer r, cl_mem *buf, size_t bytes, cl_mem_flags flags)
@@ -279,8 +281,11 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
      * adds
      * nothing, so its programs stay those of the single-buffer code. */
     if (r->volume && r->volume->slab_count > 1 && n > 0 && (size_t)n < size)
-        snprintf(buf + n, size - (size_t)n, " -DUMBRA_VOLUME_SLABS=%u -DUMBRA_SLAB_STEP=%u",
-                 r->volume->slab_count, r->volume->slab_step);
+        n += snprintf(buf + n, size - (size_t)n, " -DUMBRA_VOLUME_SLABS=%u -DUMBRA_SLAB_STEP=%u",
+                      r->volume->slab_count, r->volume->slab_step);
+    /* A part of a global grid (host/part_render.c); a whole volume adds nothing. */
+    if (r->volume && r->volume->is_part && n > 0 && (size_t)n < size)
+        snprintf(buf + n, size - (size_t)n, " -DUMBRA_PART=1");
 }
 
 umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next)

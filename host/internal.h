@@ -181,6 +181,12 @@ struct umbra_volume_t {
     uint64_t version, ranges_version;
     unsigned char *cell_clamps;
     size_t clamp_cells;
+    /* A part of a global grid (umbra/part.h, host/part.c): grid_dims is the grid the world box,
+     * the frame and the rays are made of (dims for a whole volume, the global dims for a part);
+     * part says where the carried voxels (dims) lie in it. */
+    uint32_t grid_dims[3];
+    int is_part;
+    umbra_part_desc part;
 };
 #endif
 

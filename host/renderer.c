@@ -145,7 +145,7 @@ void umbra_renderer_release(umbra_renderer r)
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
-                      &r->out_buf};
+                      &r->out_buf, &r->part_state_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         umbra__release_mem(mems[i]);
     umbra_volume_release(r->volume);
@@ -160,6 +160,7 @@ void umbra_renderer_release(umbra_renderer r)
         umbra_transfer_function_release(r->ch_light_eff[c]);
     }
     umbra__projection_release(r);
+    free(r->part_state_in);
     umbra_context_release(r->ctx);
     free(r);
 }
@@ -420,7 +421,7 @@ double umbra__ray_samples(umbra_renderer r, float step_voxels)
 {
     double diag = 0.0;
     for (int a = 0; a < 3; ++a) {
-        double e = (double)r->volume->dims[a] * r->volume->spacing[a];
+        double e = (double)r->volume->grid_dims[a] * r->volume->spacing[a];
         diag += e * e;
     }
     return sqrt(diag) / ((double)step_voxels * umbra__voxel_world(r));
@@ -481,7 +482,7 @@ static int choose_shadow(umbra_renderer r, int frame, umbra__light_key *key)
 
 /* Light tables and the shadow structure, rebuilt only when the light key changed. frame: a
  * render (progressive shadows apply), not a query. */
-static umbra_status prepare_shadow(umbra_renderer r, double build_share, int frame)
+umbra_status umbra__prepare_shadow(umbra_renderer r, double build_share, int frame)
 {
     umbra__frame_update_light(r);
     const umbra__technique *t = r->tech;
@@ -514,6 +515,7 @@ static umbra_status prepare_shadow(umbra_renderer r, double build_share, int fra
     r->built = key;
     r->built_valid = 1;
     r->stats.shadow_rebuilt = 1;
+    r->rebuilds.shadow++;
     return UMBRA_SUCCESS;
 }
 
@@ -610,6 +612,10 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     umbra_context ctx = r->ctx;
     umbra_status st = check_ready(r, fn);
     cl_event ev = NULL;
+    if (st == UMBRA_SUCCESS && r->volume->is_part && !r->part_call)
+        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: the volume is a part of a global grid: render it with "
+                           "umbra_renderer_render_part (umbra/part.h)", fn);
     if (st == UMBRA_SUCCESS)
         st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
@@ -620,7 +626,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (!r->tech->render && (st = check_ray_samples(r, r->opts.step, "view", fn)) != UMBRA_SUCCESS)
         return st;
     /* A shadow build, if one is needed, is the first half of the progress reported. */
-    st = prepare_shadow(r, 0.5, 1);
+    st = umbra__prepare_shadow(r, 0.5, 1);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
@@ -756,7 +762,7 @@ static umbra_status query_shadow(umbra_renderer r, const float *points, size_t c
                            "%s: technique '%s' has no per-point shadow lookup", fn,
                            r->tech->info.name);
     umbra__progress_begin(r);
-    if ((st = prepare_shadow(r, 0.5, 0)) != UMBRA_SUCCESS)
+    if ((st = umbra__prepare_shadow(r, 0.5, 0)) != UMBRA_SUCCESS)
         return st;
     umbra__progress_phase(r, r->progress_last, 1.0);
     if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)

@@ -17,7 +17,7 @@
 #include "common/umbra_shared.h"
 
 _Static_assert(sizeof(UmbraChannels) == 4 * 16 + 4 * 16 + 16, "UmbraChannels layout");
-_Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12 + sizeof(UmbraChannels),
+_Static_assert(sizeof(UmbraFrame) == 14 * 16 + 2 * 16 + 4 * 12 + sizeof(UmbraChannels) + 4 * 16,
                "UmbraFrame layout");
 _Static_assert(sizeof(UmbraClip) == 8 * 16 + 16, "UmbraClip layout");
 _Static_assert(sizeof(UmbraShadow) == 6 * 16 + 4 * 4 + sizeof(UmbraClip), "UmbraShadow layout");
@@ -201,6 +201,15 @@ struct umbra_renderer_t {
 
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
+    int part_call;                           /* umbra_renderer_render_part is rendering */
+    /* A part's light exchange (host/part_render.c): the march state imported (host, NULL: none
+     * yet), its device copy the build reads and writes, and the shadow build count at the last
+     * import of depths. */
+    float *part_state_in;
+    size_t part_state_floats;
+    cl_mem part_state_buf;
+    uint64_t part_depths_at;
+    int part_depths_valid;
     cl_event async_first, async_last;        /* the last asynchronous frame's first and last
                                                 kernels (retained) until the next frame: its
                                                 device time for umbra_renderer_get_stats */
@@ -378,6 +387,19 @@ umbra_status umbra__tables(umbra_renderer r, const umbra_transfer_function *tfs,
 
 /* The view (light 0) or light transfer functions in effect, one per channel of the volume. */
 void umbra__channel_tfs(umbra_renderer r, int light, umbra_transfer_function *out);
+
+/* The part fields of r->frame (host/part_render.c): zero for a whole volume; for a part its
+ * shift, carried dims and owned box, and with view set no background and no empty-space skipping
+ * (a partial image is composited before the background; skipping changes no pixel). */
+void umbra__part_frame(umbra_renderer r, int view);
+
+/* Binds a part's march state (n^2 texels) as argument index of a map's build kernel, uploading
+ * the imported state (or the light's: transmittance 1) first (host/part_render.c). */
+umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index, uint32_t n);
+
+/* Light tables and the shadow structure, rebuilt only when the light key changed
+ * (host/renderer.c). frame: a render (progressive shadows apply), not a query. */
+umbra_status umbra__prepare_shadow(umbra_renderer r, double build_share, int frame);
 
 /* The view part of the frame constants for a width x height image (host/frame.c). */
 void umbra__frame_update_view(umbra_renderer r, uint32_t width, uint32_t height);

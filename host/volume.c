@@ -312,6 +312,7 @@ static umbra_status volume_create(umbra_context ctx, const umbra_volume_desc *gi
     v->ctx = ctx;
     umbra_context_retain(ctx);
     memcpy(v->dims, desc->dims, sizeof v->dims);
+    memcpy(v->grid_dims, desc->dims, sizeof v->grid_dims);
     memcpy(v->spacing, desc->spacing, sizeof v->spacing);
     v->channels = channels;
     v->labels = desc->labels != 0;
@@ -626,7 +627,7 @@ umbra_status umbra_volume_get_info(umbra_volume v, umbra_volume_info *out)
     for (int a = 0; a < 3; ++a) {
         out->dims[a] = v->dims[a];
         out->spacing[a] = v->spacing[a];
-        out->extent[a] = (float)v->dims[a] * v->spacing[a];
+        out->extent[a] = (float)v->grid_dims[a] * v->spacing[a]; /* a part: the global box */
         out->brick_counts[a] = v->brick_counts[a];
     }
     out->value_min = v->value_min;

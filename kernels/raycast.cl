@@ -180,7 +180,16 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
          * are taken with their light at once, before the loop below. Only where nothing is clipped
          * in front of the box's face: a clipped ray starts at its first jittered sample past the
          * clip (k0). */
+#if UMBRA_PART
+        /* A part takes the two unjittered samples only if it owns the first; every part then
+         * goes on from k = 1, and from the first sample its box may hold. */
+        const int own0 = part_owns(F, world_to_voxel(g, o + t0 * d));
+        if (jitter > 0.0f && !(tc.x > t0) && !own0)
+            k = 1;
+        if (jitter > 0.0f && !(tc.x > t0) && own0) {
+#else
         if (jitter > 0.0f && !(tc.x > t0)) {
+#endif
             for (int pre = 0; pre < 2 && alpha <= termination; ++pre) {
                 const float tp = t0 + (float)pre * h;
                 if (!(tp < t1))
@@ -213,6 +222,21 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
             }
             k = alpha > termination ? n : 1;
         }
+#if UMBRA_PART
+        {
+            /* The core box grown by a voxel (finite at the global faces): a ray that misses it
+             * takes no sample of the part, and none before its entry. */
+            const float3 dims = convert_float3(g.dims);
+            const float3 lo = fmax(F3(F->part_lo), 0.0f) - 1.0f;
+            const float3 hi = fmin(F3(F->part_hi), dims) + 1.0f;
+            const float2 pb = ray_box(o, d, g.box_min + lo * g.spacing, g.box_min + hi * g.spacing);
+            if (!(pb.y >= pb.x))
+                k = n;
+            else if (pb.x > t0)
+                k = max(k, (int)floor((pb.x - t0) / h - jitter) - 1);
+        }
+        int owned = 0;
+#endif
         for (;;) {
             int more = k < n;
             float t = 0.0f;
@@ -224,6 +248,17 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                     t = t0 + ((float)k + jitter) * h;
                 }
             }
+#if UMBRA_PART
+            /* Samples before the part's are passed over; the first after them ends the ray. */
+            if (more && !part_owns(F, xo + t * xd)) {
+                if (!owned) {
+                    ++k;
+                    continue;
+                }
+                more = 0;
+            }
+            owned |= more;
+#endif
             float3 p = o + t * d;
             float4 c = (float4)(0.0f);
             if (more) {

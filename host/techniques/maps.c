@@ -136,6 +136,9 @@ umbra_status umbra__map_build(umbra_renderer r, double *ms)
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next++, sizeof(cl_mem), &s->constants_buf));
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
+    /* A part's march goes on from the state the parts before it left (host/part_render.c). */
+    if (r->volume->is_part && (st = umbra__part_bind_build(r, s->build_kernel, next + 1, n)))
+        return st;
     const size_t blocks = (n + block - 1) / block;
     size_t global[2] = {blocks, blocks};
     st = umbra__run_2d(r, s->build_kernel, global, NULL,
@@ -195,6 +198,20 @@ const void *umbra__map_constants(umbra_renderer r)
 {
     const map_state *s = r->tech_state;
     return s && s->built ? s->constants : NULL;
+}
+
+umbra_status umbra__map_write(umbra_renderer r, const void *data, size_t bytes)
+{
+    const map_state *s = r->tech->build == umbra__map_build ? r->tech_state : NULL;
+    umbra_status st = UMBRA_SUCCESS;
+    umbra_context ctx = r->ctx;
+    if (!s || !s->map || !s->built || bytes != s->map_bytes)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra__map_write: %zu bytes for a map of %zu (built: %d)", bytes,
+                           s ? s->map_bytes : (size_t)0, s ? s->built : 0);
+    UMBRA_CL(clEnqueueWriteBuffer(ctx->queue, s->map, CL_TRUE, 0, bytes, data, 0, NULL, NULL));
+fail:
+    return st;
 }
 
 umbra_status umbra__map_read(umbra_renderer r, void *out, size_t bytes)

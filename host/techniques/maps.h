@@ -56,4 +56,7 @@ const void *umbra__map_constants(umbra_renderer r);
  * a smaller out. */
 umbra_status umbra__map_read(umbra_renderer r, void *out, size_t bytes);
 
+/* Overwrites the built map with bytes (its whole size) of data: a part's imported depths. */
+umbra_status umbra__map_write(umbra_renderer r, const void *data, size_t bytes);
+
 #endif

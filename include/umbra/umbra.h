@@ -12,5 +12,6 @@
 #include "umbra/renderer.h"
 #include "umbra/registry.h"
 #include "umbra/scene.h"
+#include "umbra/part.h"
 
 #endif

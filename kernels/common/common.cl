@@ -33,6 +33,9 @@ typedef struct VolGeom {
     int cell_size; /* voxels along a brick's sub-cell: ceil(brick_size / UMBRA_BRICK_CELLS) */
     float value_lo, value_scale, image_scale; /* UmbraFrame.value_map (kernels/common/sampling.cl)
     */
+#if UMBRA_PART
+    int3 part_shift, part_dims; /* UmbraFrame.part_shift, part_dims (sampling.cl, PART_INDEX) */
+#endif
 } VolGeom;
 
 inline VolGeom vol_geom(__global const UmbraFrame *F)
@@ -49,8 +52,23 @@ inline VolGeom vol_geom(__global const UmbraFrame *F)
     g.value_lo = F->value_map[0];
     g.value_scale = F->value_map[1];
     g.image_scale = F->value_map[2];
+#if UMBRA_PART
+    g.part_shift = (int3)(F->part_shift[0], F->part_shift[1], F->part_shift[2]);
+    g.part_dims = (int3)(F->part_dims[0], F->part_dims[1], F->part_dims[2]);
+#endif
     return g;
 }
+
+#if UMBRA_PART
+/* Whether the part owns the sample at voxel coordinates x (UmbraFrame.part_lo, part_hi): the
+ * half-open core box, so a sample on a face two parts share is taken by one of them (view
+ * samples, kernels/raycast.cl, and light-ray segments by their midpoint). */
+inline int part_owns(__global const UmbraFrame *F, float3 x)
+{
+    const float3 c = x + 0.5f;
+    return all(c >= F3(F->part_lo)) && all(c < F3(F->part_hi));
+}
+#endif
 
 /* Slab test: the parametric interval [t0, t1] where o + t d lies in [bmin, bmax] (faces
  * included); t1 < t0 when the ray misses. Division by a zero component gives +-inf, which the

@@ -180,6 +180,17 @@ UMBRA_INLINE float voxel_blended(VolGeom g, float b)
 #endif
 }
 
+/* A part of a global grid (UMBRA_PART, umbra/part.h): positions and clamping are those of the
+ * global grid (g.dims), and the carried voxels are addressed from global indices less
+ * g.part_shift, clamped to what the part carries (g.part_dims). A whole volume: the identity. */
+#if UMBRA_PART
+#define PART_INDEX(i) clamp((i) - g.part_shift, (int3)(0), g.part_dims - 1)
+#define PART_DIMS g.part_dims
+#else
+#define PART_INDEX(i) (i)
+#define PART_DIMS g.dims
+#endif
+
 #if UMBRA_VOLUME_SLABS > 1
 /* The buffer of slab s. */
 UMBRA_INLINE __global const UMBRA_VOXEL_T *volume_slab(VOLUME_PARAM, int s)
@@ -218,6 +229,10 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     int3 i0 = convert_int3(x);
     float3 f = x - convert_float3(i0);
     int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_PART
+    i0 = PART_INDEX(i0);
+    i1 = PART_INDEX(i1);
+#endif
 #if UMBRA_VOLUME_SLABS == 1
     __global const UMBRA_VOXEL_T *restrict v = vol;
 #else
@@ -227,7 +242,7 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     i0.z -= s * UMBRA_SLAB_STEP;
     i1.z -= s * UMBRA_SLAB_STEP;
 #endif
-    size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+    size_t sy = (size_t)PART_DIMS.x, sz = (size_t)PART_DIMS.x * (size_t)PART_DIMS.y;
     size_t z0 = (size_t)i0.z * sz, z1 = (size_t)i1.z * sz;
     size_t y0 = (size_t)i0.y * sy, y1 = (size_t)i1.y * sy;
     float2 c0 = voxel_load2(v, g, z0 + y0 + i0.x), c1 = voxel_load2(v, g, z0 + y1 + i0.x);
@@ -261,6 +276,10 @@ UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
 UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
 {
     int3 i1 = min(i0 + 1, g.dims - 1);
+#if UMBRA_PART
+    i0 = PART_INDEX(i0);
+    i1 = PART_INDEX(i1);
+#endif
 #if UMBRA_VOLUME_SLABS == 1
     __global const UMBRA_VOXEL_T *restrict v = vol;
 #else
@@ -355,7 +374,13 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
     int3 top = g.dims - 1;
     int3 a = clamp(i - 1, (int3)(0), top), b = clamp(i, (int3)(0), top);
     int3 c = clamp(i + 1, (int3)(0), top), d = clamp(i + 2, (int3)(0), top);
-    size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+#if UMBRA_PART
+    a = PART_INDEX(a);
+    b = PART_INDEX(b);
+    c = PART_INDEX(c);
+    d = PART_INDEX(d);
+#endif
+    size_t sy = (size_t)PART_DIMS.x, sz = (size_t)PART_DIMS.x * (size_t)PART_DIMS.y;
     size_t xa = (size_t)a.x, xb = (size_t)b.x, xc = (size_t)c.x, xd = (size_t)d.x;
     size_t ya = (size_t)a.y * sy, yb = (size_t)b.y * sy;
     size_t yc = (size_t)c.y * sy, yd = (size_t)d.y * sy;

@@ -9,6 +9,9 @@
 #define UMBRA_SHARED_H
 
 #ifdef __OPENCL_VERSION__
+#ifndef UMBRA_PART
+#define UMBRA_PART 0 /* 1: the volume is a part of a global grid (umbra/part.h) */
+#endif
 typedef uint uint32_t;
 typedef int int32_t;
 #define F3(a) ((float3)((a)[0], (a)[1], (a)[2]))
@@ -79,6 +82,15 @@ typedef struct UmbraFrame {
     float kd, ks, shininess;
     uint32_t tf_size, light_tf_size;
     UmbraChannels ch;      /* a multi-channel volume's channels, or a label map */
+    /* A part of a global grid (programs built with UMBRA_PART 1, host/part_render.c): dims
+     * above are the global grid's; the carried voxels start at global voxel part_shift
+     * (offset - ghost_lo) and number part_dims; the part owns the view samples at voxel
+     * coordinates x with part_lo <= x + 0.5 < part_hi (-inf and +inf at the global grid's outer
+     * faces). Zero for a whole volume. */
+    int32_t part_shift[4];
+    int32_t part_dims[4];
+    float part_lo[4];
+    float part_hi[4];
 } UmbraFrame;
 
 /* The clip region (umbra_renderer_set_clip, filled by host/clip.c in the volume's local frame):

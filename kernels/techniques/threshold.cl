@@ -30,7 +30,11 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
                               __global const float4 *view_tf, __global const float4 *light_tf,
                               __global const uchar *view_bricks,
                               __global const ulong *light_cells, __global const UmbraShadow *S,
-                              __global const UmbraThreshold *P, __global float *map)
+                              __global const UmbraThreshold *P, __global float *map
+#if UMBRA_PART
+                              , __global float *part_state
+#endif
+                              )
 {
     const int x = get_global_id(0), y = get_global_id(1);
     const int n = (int)S->map_size;
@@ -61,6 +65,13 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
         const float tau_thr = -log1p(-thr), p_thr = exp(-tau_thr / h_vox);
         const int product = p_thr > 1e-30f;
         float tau = 0.0f, P = 1.0f;
+#if UMBRA_PART
+        /* A part goes on with the march state the parts before it on this ray left
+         * (host/part_render.c): the same product and sum as one device's march, bit for bit. */
+        P = part_state[2 * (y * n + x)];
+        tau = part_state[2 * (y * n + x) + 1];
+        int owned = 0;
+#endif
         CellWalk w = walk_begin(g, o, d, tb.x);
         float t_cell = -UMBRA_INF;
         /* Segment k covers [tb.x + k h, tb.x + (k + 1) h]; k == n_full is the partial one. Whole
@@ -74,6 +85,16 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             const float t_start = tb.x + (float)k * h;
             const float t_mid = t_start + 0.5f * seg;
             const float3 q = o + t_mid * d;
+#if UMBRA_PART
+            /* Only the segments whose midpoint the part owns; the first after them ends it. */
+            if (!part_owns(F, world_to_voxel(g, q))) {
+                if (owned)
+                    break;
+                ++k;
+                continue;
+            }
+            owned = 1;
+#endif
             const float4 c = light_sample(F, vol, g, light_tf, n_tf, q);
             if (c.w > 0.0f) {
                 if (product) {
@@ -100,6 +121,10 @@ __kernel void threshold_build(__global const UmbraFrame *F, VOLUME_PARAM,
             }
             ++k;
         }
+#if UMBRA_PART
+        part_state[2 * (y * n + x)] = P;
+        part_state[2 * (y * n + x) + 1] = tau;
+#endif
     }
     map[y * n + x] = depth;
 }
