@@ -269,6 +269,9 @@ static void usage(FILE *f)
         "  --images MODE    PNGs under DIR/images: none, headline (default), all\n"
         "  --cache DIR      reference-image cache (default DIR/cache)\n"
         "  --no-cache       render the exact references again (and refresh the cache)\n"
+        "  --merge CSV      keep the rows of an earlier accuracy.csv that this run does not\n"
+        "                   measure (same scene, technique and params), and report them all\n"
+        "  --report         measure nothing: write the outputs from the --merge rows alone\n"
         "  --no-plots       skip gnuplot\n"
         "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
         "  --main NAME      the scene of the headline's first table (default walnut)\n"
@@ -336,6 +339,11 @@ static int parse_options(int argc, char **argv, options *o)
             ++i;
         } else if (strcmp(a, "--out") == 0 && v) {
             snprintf(o->out, sizeof o->out, "%s", v);
+            ++i;
+        } else if (strcmp(a, "--report") == 0) {
+            o->report = 1;
+        } else if (strcmp(a, "--merge") == 0 && v) {
+            snprintf(o->merge, sizeof o->merge, "%s", v);
             ++i;
         } else if (strcmp(a, "--cache") == 0 && v) {
             snprintf(o->cache_dir, sizeof o->cache_dir, "%s", v);
@@ -421,11 +429,20 @@ static int load_scenes(bench_run *B)
     qsort(names, (size_t)n, sizeof names[0], cmp_str);
     char data_dir[SCENE_PATH_MAX];
     scene_data_dir(UMBRA_SOURCE_DIR, data_dir, sizeof data_dir);
+    char merged[1024] = "";
+    if (B->o.merge[0] && (accuracy_merge_read(B->o.merge) != 0 ||
+                          accuracy_merge_scene_names(merged, sizeof merged) != 0)) {
+        fprintf(stderr, "umbra-bench accuracy: --merge %s: cannot read it\n", B->o.merge);
+        for (int i = 0; i < n; ++i)
+            free(names[i]);
+        return -1;
+    }
     int rc = 0;
     for (int i = 0; i < n; ++i) {
         char path[SCENE_PATH_MAX + 512], err[1024], stem[SCENE_NAME_MAX];
         snprintf(stem, sizeof stem, "%.*s", (int)(strlen(names[i]) - 6), names[i]);
-        if (B->o.scenes[0] && !in_list(B->o.scenes, stem))
+        const int from_merge = in_list(merged, stem);
+        if (B->o.scenes[0] && !in_list(B->o.scenes, stem) && !from_merge)
             continue;
         snprintf(path, sizeof path, "%s/%s", B->o.scene_dir, names[i]);
         scene_spec *s = &B->scenes[B->scene_count];
@@ -434,9 +451,13 @@ static int load_scenes(bench_run *B)
             rc = -1;
             break;
         }
-        if (B->o.quick && !s->quick && !B->o.scenes[0])
+        const int selected = B->o.report      ? 0
+                             : B->o.scenes[0] ? in_list(B->o.scenes, stem)
+                                              : !(B->o.quick && !s->quick);
+        if (!selected && !from_merge)
             continue;
-        B->present[B->scene_count] = scene_volume_present(s);
+        B->merged_only[B->scene_count] = !selected;
+        B->present[B->scene_count] = !selected || scene_volume_present(s);
         ++B->scene_count;
     }
     for (int i = 0; i < n; ++i)
@@ -465,6 +486,10 @@ int bench_accuracy(int argc, char **argv)
     int prc = parse_options(argc, argv, &B.o);
     if (prc != 0)
         return prc > 0 ? 0 : 2;
+    if (B.o.report && !B.o.merge[0]) {
+        fprintf(stderr, "umbra-bench accuracy: --report needs --merge CSV\n");
+        return 2;
+    }
     if (load_scenes(&B) != 0)
         return 2;
 
@@ -481,7 +506,7 @@ int bench_accuracy(int argc, char **argv)
                        L.items[i].label, L.items[i].params,
                        L.items[i].headline ? " [headline]" : "");
         }
-        if (B.present[si])
+        if (B.present[si] && !B.merged_only[si])
             B.run_total += L.count;
     }
     if (B.o.list)
@@ -503,6 +528,8 @@ int bench_accuracy(int argc, char **argv)
             B.scene_count == 1 ? "" : "s", B.o.out);
     B.t_start = bench_now_ms();
     for (int si = 0; si < B.scene_count; ++si) {
+        if (B.merged_only[si])
+            continue;
         if (!B.present[si]) {
             accuracy_add_note(&B, "%s skipped: volume %s is not present", B.scenes[si].name,
                               B.scenes[si].volume);
@@ -512,6 +539,8 @@ int bench_accuracy(int argc, char **argv)
         /* After every scene, so that an interrupted sweep leaves what it measured. */
         accuracy_write_csv(&B);
     }
+    if (B.o.merge[0])
+        accuracy_merge_rows(&B);
     accuracy_pareto(&B);
     accuracy_write_csv(&B);
     accuracy_write_headline(&B);
@@ -519,10 +548,11 @@ int bench_accuracy(int argc, char **argv)
     if (B.o.plots)
         accuracy_write_plots(&B);
     accuracy_write_summary(&B);
+    accuracy_write_texel(&B);
     char e[32];
     accuracy_format_duration(bench_now_ms() - B.t_start, e, sizeof e);
     fprintf(stderr, "accuracy: %d runs in %s; wrote %s/{accuracy.csv,summary.md,headline.md,"
-                    "papers.md,plots/}%s\n", B.result_count, e, B.o.out,
+                    "papers.md,texel.md,plots/}%s\n", B.result_count, e, B.o.out,
             B.failures ? "; SOME RUNS FAILED (see summary.md notes)" : "");
     for (int i = 0; i < B.notes.count; ++i)
         free(B.notes.items[i]);

@@ -22,6 +22,25 @@
 
 #ifndef UMBRA_SOURCE_DIR
 #define UMBRA_SOURCE_DIR "."
+/* ---- bench/accuracy_texel.c ------------------------------------------------------------------ */
+
+/* <out>/texel.md: per scene the Pareto front over bytes per map texel (after accuracy_pareto)
+ * and its plot, and the moment map against CSSM and the deep map at equal memory. */
+void accuracy_write_texel(bench_run *B);
+
+/* ---- bench/accuracy_merge.c ------------------------------------------------------------------ */
+
+/* Reads the --merge file into memory (before the run can overwrite it); 0, or -1. */
+int accuracy_merge_read(const char *path);
+
+/* The scene names of the merge file's rows, comma-separated into names; -1 if unread. */
+int accuracy_merge_scene_names(char *names, size_t size);
+
+/* Adds the rows of B->o.merge that this run did not measure (same scene, technique and params)
+ * to B->results, and puts all rows in the sweep's order; a file that cannot be read is a
+ * failure. */
+void accuracy_merge_rows(bench_run *B);
+
 #endif
 
 #define MAX_CONFIGS 96
@@ -78,6 +97,7 @@ typedef struct result {
     /* The yardstick's own error: the scene's reference at its step against the reference at half
      * that step (display values, as err); rmse < 0 when it could not be measured. */
     metrics_error ref_unc;
+    int order; /* --merge: the row's place in the sweep (bench/accuracy_merge.c) */
 } result;
 
 typedef struct note_list {
@@ -88,11 +108,13 @@ typedef struct note_list {
 /* The command line (accuracy.c parse_options). */
 typedef struct options {
     int quick, runs, warmup, plots, list;
+    int report; /* --report: nothing measured, the outputs from the --merge rows */
     int cache; /* read cached references (0: --no-cache); they are written either way */
     const char *images;      /* none | headline | all */
     char out[2048], cache_dir[2100], scene_dir[2048], main_scene[SCENE_NAME_MAX];
     char scenes[1024];       /* comma-separated names, "" for all */
     char techniques[256];    /* comma-separated technique names, "" for all */
+    char merge[2048];        /* --merge: an earlier accuracy.csv whose other rows are kept */
     const char *device;
     uint32_t max_map;
 } options;
@@ -103,6 +125,7 @@ typedef struct bench_run {
     umbra_context ctx;
     scene_spec scenes[MAX_SCENES];
     int present[MAX_SCENES];
+    int merged_only[MAX_SCENES]; /* scenes whose rows all come from --merge: not run */
     int scene_count;
     result *results;
     int result_count, result_cap;
@@ -181,5 +204,24 @@ void accuracy_write_summary(bench_run *B);
 
 /* <out>/papers.md: the seed papers' timing tables beside ours. */
 void accuracy_write_papers(bench_run *B);
+
+/* ---- bench/accuracy_texel.c ------------------------------------------------------------------ */
+
+/* <out>/texel.md: per scene the Pareto front over bytes per map texel (after accuracy_pareto)
+ * and its plot, and the moment map against CSSM and the deep map at equal memory. */
+void accuracy_write_texel(bench_run *B);
+
+/* ---- bench/accuracy_merge.c ------------------------------------------------------------------ */
+
+/* Reads the --merge file into memory (before the run can overwrite it); 0, or -1. */
+int accuracy_merge_read(const char *path);
+
+/* The scene names of the merge file's rows, comma-separated into names; -1 if unread. */
+int accuracy_merge_scene_names(char *names, size_t size);
+
+/* Adds the rows of B->o.merge that this run did not measure (same scene, technique and params)
+ * to B->results, and puts all rows in the sweep's order; a file that cannot be read is a
+ * failure. */
+void accuracy_merge_rows(bench_run *B);
 
 #endif

@@ -437,8 +437,10 @@ void accuracy_write_headline(bench_run *B)
                "the exact reference at its step against the exact reference at half that step, "
                "the yardstick's uncertainty (an RMSE near it is not a measured error); speed-up: "
                "the exact "
-               "reference's render time over build + render. Device: %s. %s.\n",
-            B->device, B->started);
+               "reference's render time over build + render. %s%s. %s.\n",
+            B->o.report ? "Measured in earlier runs (their rows joined by --report; the "
+                          "summary's notes)" : "Device: ",
+            B->o.report ? "" : B->device, B->started);
     fclose(f);
 }
 

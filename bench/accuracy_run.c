@@ -99,6 +99,9 @@ void accuracy_write_machine(bench_run *B, FILE *f)
 {
     double load_end[3];
     read_loadavg(load_end);
+    if (B->o.report)
+        fprintf(f, "- Written by `--report` from rows measured in earlier runs (`--merge %s`): "
+                   "the machine below wrote the outputs and measured nothing\n", B->o.merge);
     fprintf(f, "- Started: %s; umbra commit %s\n", B->started, B->commit);
     fprintf(f, "- CPU: %s\n", B->machine);
     fprintf(f, "- OpenCL device: %s\n", B->device);
@@ -106,6 +109,11 @@ void accuracy_write_machine(bench_run *B, FILE *f)
     fprintf(f, "- Load average (1, 5, 15 min) at start %.2f %.2f %.2f, at the end %.2f %.2f %.2f\n",
             B->load_start[0], B->load_start[1], B->load_start[2], load_end[0], load_end[1],
             load_end[2]);
+    if (B->o.report) {
+        fprintf(f, "- Mode: %s; timed runs per setting as each row's runs column says\n",
+                B->o.quick ? "--quick" : "full sweep");
+        return;
+    }
     fprintf(f, "- Mode: %s; %d timed run%s per setting after %d warm-up frame%s (fewer for slow "
                "settings, see the runs column)\n",
             B->o.quick ? "--quick" : "full sweep", B->o.runs, B->o.runs == 1 ? "" : "s",

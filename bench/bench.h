@@ -115,6 +115,10 @@ umbra_context bench_context(const char *device);
 /* Table formatting shared by the subcommands: "0", "812.0 KiB", "3.1 MiB", "1.25 GiB"; and
  * milliseconds with three significant digits ("1234", "56.7", "8.91"). */
 void bench_format_bytes(size_t bytes, char *buf, size_t size);
+
+/* Splits a CSV line without quoting (accuracy.csv has none) in place at its commas, the line end
+ * cut off; returns the field count (at most max). */
+int bench_split_csv(char *line, char **fields, int max);
 void bench_format_ms(double ms, char *buf, size_t size);
 
 #endif

@@ -499,3 +499,19 @@ void bench_format_ms(double ms, char *buf, size_t size)
     else
         snprintf(buf, size, "%.2f", ms);
 }
+
+/* Splits a CSV line (no quoting: accuracy.csv has none) in place; returns the field count. */
+int bench_split_csv(char *line, char **fields, int max)
+{
+    int n = 0;
+    line[strcspn(line, "\r\n")] = '\0';
+    for (char *p = line; n < max;) {
+        fields[n++] = p;
+        char *comma = strchr(p, ',');
+        if (!comma)
+            break;
+        *comma = '\0';
+        p = comma + 1;
+    }
+    return n;
+}

@@ -18,7 +18,10 @@
  *             plots;
  *   gallery   the main scene's pictures from the same run (DIR/images/SCENE/, written by
  *             `--images headline`), one table row each with the build time, render time, memory,
- *             light channels and error read from accuracy.csv.
+ *             light channels and error read from accuracy.csv;
+ *   texel     DIR/texel.md, every scene's plot of RMSE against bytes per map texel, its Pareto
+ *             front and the moment map at equal memory.
+ * `NAME SUB` takes the block from the results' folder SUB instead (DIR/SUB: a second sweep). 
  * Links are written relative to each file's folder. `--check` changes nothing and exits 1 when a
  * file is out of date (for a pre-commit check and the docs_check test). */
 #define _XOPEN_SOURCE 700
@@ -123,22 +126,6 @@ static void image_name(const char *technique, const char *params, char *out, siz
             *s = '_';
 }
 
-/* Splits a CSV line (no quoting: accuracy.csv has none) in place; returns the field count. */
-static int split_csv(char *line, char **fields, int max)
-{
-    int n = 0;
-    line[strcspn(line, "\r\n")] = '\0';
-    for (char *p = line; n < max;) {
-        fields[n++] = p;
-        char *comma = strchr(p, ',');
-        if (!comma)
-            break;
-        *comma = '\0';
-        p = comma + 1;
-    }
-    return n;
-}
-
 static int column(char **header, int n, const char *name)
 {
     for (int i = 0; i < n; ++i)
@@ -208,6 +195,31 @@ static int block_headline(const job *J, text *out)
     return rc;
 }
 
+/* DIR/texel.md: the maps' error against bytes per texel, its links made relative to the file. */
+static int block_texel(const job *J, text *out)
+{
+    char path[PATH_MAX + 64], link[PATH_MAX + 8];
+    snprintf(path, sizeof path, "%s/texel.md", J->results);
+    snprintf(link, sizeof link, "%s/", J->link);
+    char *md = read_file(path);
+    if (!md) {
+        fprintf(stderr, "readme: cannot read %s: %s (run `umbra-bench accuracy` first)\n", path,
+                strerror(errno));
+        return -1;
+    }
+    text t = {0};
+    int rc = add_lines(&t, md);
+    free(md);
+    for (const char *p = t.s; rc == 0 && p && *p;) {
+        const char *at = strstr(p, "](plots/");
+        const size_t n = at ? (size_t)(at - p) + 2 : strlen(p);
+        rc = text_add(out, p, n) || (at && text_add(out, link, strlen(link)));
+        p += n;
+    }
+    free(t.s);
+    return rc;
+}
+
 /* The headline table's all-scenes part, for the README's choice of a technique. */
 static int block_choose(const job *J, text *out) { return add_headline(J, out, 1); }
 
@@ -223,9 +235,9 @@ static int block_gallery(const job *J, text *out)
     }
     char header_line[4096], line[4096];
     char *header[MAX_COLUMNS], *v[MAX_COLUMNS];
-    int nh = fgets(header_line, sizeof header_line, f) ? split_csv(header_line, header,
-                                                                    MAX_COLUMNS)
-                                                       : 0;
+    int nh = fgets(header_line, sizeof header_line, f)
+                 ? bench_split_csv(header_line, header, MAX_COLUMNS)
+                 : 0;
     const char *names[] = {"scene",  "technique",    "label",          "params",
                            "width",  "height",       "build_ms",       "render_ms",
                            "memory_bytes", "light_channels", "rmse", "ssim"};
@@ -240,7 +252,7 @@ static int block_gallery(const job *J, text *out)
         }
     int rows = 0, rc = 0;
     while (rc == 0 && fgets(line, sizeof line, f)) {
-        int n = split_csv(line, v, MAX_COLUMNS);
+        int n = bench_split_csv(line, v, MAX_COLUMNS);
         if (n != nh || strcmp(v[col[SCENE]], J->scene) != 0)
             continue;
         char name[512], image[PATH_MAX + 700];
@@ -309,6 +321,23 @@ static int regenerate(const job *J, const char *src, text *out)
         }
         char block[64];
         snprintf(block, sizeof block, "%.*s", (int)(close - name), name);
+        /* "NAME SUB": the block from the results' folder SUB (a folder name, no "..") */
+        job K = *J;
+        char *arg = strchr(block, ' ');
+        if (arg) {
+            *arg++ = '\0';
+            const size_t rl = strlen(K.results), ll = strlen(K.link), al = strlen(arg);
+            if (strstr(arg, "..") || strchr(arg, ' ') || rl + al + 2 > sizeof K.results ||
+                ll + al + 2 > sizeof K.link) {
+                fprintf(stderr, "readme: %s: bad folder '%s' in block '%s'\n", J->readme, arg,
+                        block);
+                return -1;
+            }
+            K.results[rl] = '/';
+            memcpy(K.results + rl + 1, arg, al + 1);
+            K.link[ll] = '/';
+            memcpy(K.link + ll + 1, arg, al + 1);
+        }
         const char *after_open = close + 4;
         if (*after_open == '\n')
             ++after_open;
@@ -316,13 +345,15 @@ static int regenerate(const job *J, const char *src, text *out)
             return -1;
         int rc;
         if (strcmp(block, "headline") == 0)
-            rc = block_headline(J, out);
+            rc = block_headline(&K, out);
         else if (strcmp(block, "choose") == 0)
-            rc = block_choose(J, out);
+            rc = block_choose(&K, out);
         else if (strcmp(block, "gallery") == 0)
-            rc = block_gallery(J, out);
+            rc = block_gallery(&K, out);
+        else if (strcmp(block, "texel") == 0)
+            rc = block_texel(&K, out);
         else {
-            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery)\n",
+            fprintf(stderr, "readme: %s: unknown block '%s' (choose, headline, gallery, texel)\n",
                     J->readme, block);
             rc = -1;
         }
@@ -386,7 +417,8 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: umbra-bench readme [--readme FILE] [--results DIR] [--scene NAME] "
                "[--check]\n"
-               "  rewrites the '" MARK_BEGIN "choose|headline|gallery -->' blocks of README.md,\n"
+               "  rewrites the '" MARK_BEGIN "NAME [SUB] -->' blocks (NAME: choose,\n"
+               "  headline, gallery or texel; SUB: a folder of the results) of README.md,\n"
                "  docs/accuracy.md and any other docs/*.md holding one, from the results of\n"
                "  `umbra-bench accuracy`\n"
                "  --readme FILE   only this file\n"
