@@ -153,16 +153,18 @@ static float *render_whole(umbra_context ctx, const float *voxels, umbra_transfe
     return img;
 }
 
-/* The voxels of [lo, lo + n) per axis of the global grid. */
+/* The voxels of [lo, lo + n) per axis of the global grid; voxels past the grid (a part that
+ * overflows it, for the refusal tests) are 0. */
 static float *sub_box(const float *voxels, const uint32_t lo[3], const uint32_t n[3])
 {
-    float *b = malloc((size_t)n[0] * n[1] * n[2] * sizeof *b);
+    float *b = calloc((size_t)n[0] * n[1] * n[2], sizeof *b);
     assert_non_null(b);
-    for (uint32_t z = 0; z < n[2]; ++z)
-        for (uint32_t y = 0; y < n[1]; ++y)
+    const uint32_t nx = lo[0] >= NX ? 0 : (n[0] < NX - lo[0] ? n[0] : NX - lo[0]);
+    for (uint32_t z = 0; z < n[2] && lo[2] + z < NZ; ++z)
+        for (uint32_t y = 0; y < n[1] && lo[1] + y < NY; ++y)
             memcpy(b + ((size_t)z * n[1] + y) * n[0],
                    voxels + ((size_t)(lo[2] + z) * NY + lo[1] + y) * NX + lo[0],
-                   n[0] * sizeof *b);
+                   nx * sizeof *b);
     return b;
 }
 
