@@ -83,7 +83,9 @@ static void release_kernels(umbra_renderer r)
         clReleaseKernel(r->render_kernel);
     if (r->query_kernel)
         clReleaseKernel(r->query_kernel);
-    r->render_kernel = r->query_kernel = NULL;
+    if (r->grad_kernel)
+        clReleaseKernel(r->grad_kernel);
+    r->render_kernel = r->query_kernel = r->grad_kernel = NULL;
     r->program = NULL; /* owned by the context's cache */
 }
 
@@ -145,7 +147,7 @@ void umbra_renderer_release(umbra_renderer r)
     umbra__preint_release(r->preint);
     cl_mem *mems[] = {&r->frame_buf, &r->shadow_buf, &r->samples_buf, &r->view_tf_buf,
                       &r->light_tf_buf, &r->view_bricks_buf, &r->light_cells_buf, &r->view_cells_buf,
-                      &r->out_buf, &r->part_state_buf};
+                      &r->out_buf, &r->part_state_buf, &r->grad_buf};
     for (size_t i = 0; i < sizeof mems / sizeof mems[0]; ++i)
         umbra__release_mem(mems[i]);
     umbra_volume_release(r->volume);
@@ -560,6 +562,8 @@ static umbra_status ensure_kernels(umbra_renderer r)
     st = umbra__kernel_create(r->ctx, program, "raycast_render", &r->render_kernel);
     if (st == UMBRA_SUCCESS)
         st = umbra__kernel_create(r->ctx, program, "raycast_query_shadow", &r->query_kernel);
+    if (st == UMBRA_SUCCESS)
+        st = umbra__kernel_create(r->ctx, program, "raycast_gradient_volume", &r->grad_kernel);
     if (st != UMBRA_SUCCESS) {
         release_kernels(r);
         return st;
@@ -572,6 +576,60 @@ static umbra_status ensure_kernels(umbra_renderer r)
 static umbra_timing measured_timing(umbra_renderer r)
 {
     return r->ctx->profiling ? UMBRA_TIMING_DEVICE : UMBRA_TIMING_WALL;
+}
+
+/* The shading gradient volume for this frame (kernels/common/sampling.cl, gradient_volume_entry):
+ * *on is 1 and *buf the volume's gradients where the frame shades a plain whole volume of
+ * integers in one buffer whose (dims + 3)^3 entries of 8 bytes fit one allocation, made again when the volume, its
+ * version or the program changed; else *on is 0, *buf any buffer, and a gradient volume held
+ * is released (only shaded frames pay its memory). The kernel reads it in place of the 32-voxel
+ * stencil, the same gradient bit for bit. */
+static umbra_status gradient_volume(umbra_renderer r, cl_mem *buf, cl_uint *on)
+{
+    umbra_context ctx = r->ctx;
+    umbra_status st = UMBRA_SUCCESS;
+    const umbra_volume v = r->volume;
+    *buf = r->view_tf_buf;
+    *on = 0;
+    const uint64_t n[3] = {(uint64_t)v->dims[0] + 3, (uint64_t)v->dims[1] + 3,
+                           (uint64_t)v->dims[2] + 3};
+    const uint64_t bytes = n[0] * n[1] * n[2] * 8u;
+    /* int16 differences are exact for integer voxels loaded as stored that span <= 32767 */
+    const int exact = !v->clamps && v->stored_form == UMBRA__STORED_RAW &&
+                      (v->stored_type == UMBRA_UINT8 ||
+                       ((v->stored_type == UMBRA_UINT16 || v->stored_type == UMBRA_INT16) &&
+                        (double)v->value_max - (double)v->value_min <= 32767.0));
+    umbra__device_limits lim;
+    int wanted = r->opts.shading && r->grad_kernel && exact && !umbra__volume_images(v) &&
+                 v->slab_count == 1 && !v->is_part && !v->labels && v->channels <= 1;
+    if (wanted && (umbra__device_limits_get(ctx, 0, &lim) != UMBRA_SUCCESS ||
+                   bytes > lim.max_alloc || bytes > SIZE_MAX))
+        wanted = 0;
+    const uint64_t key[3] = {v->id, v->version, (uint64_t)(uintptr_t)r->program};
+    if (!wanted || (r->grad_buf && memcmp(key, r->grad_key, sizeof key) != 0))
+        umbra__release_mem(&r->grad_buf);
+    if (!wanted)
+        return UMBRA_SUCCESS;
+    if (!r->grad_buf) {
+        cl_int err;
+        r->grad_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_WRITE, (size_t)bytes, NULL, &err);
+        UMBRA_CL_CHECK(err, "clCreateBuffer");
+        /* raycast_gradient_volume(F, vol, out), after the frame's wait list */
+        UMBRA_CL(clSetKernelArg(r->grad_kernel, 0, sizeof(cl_mem), &r->frame_buf));
+        UMBRA_CL(clSetKernelArg(r->grad_kernel, 1, sizeof(cl_mem), &v->slabs[0]));
+        UMBRA_CL(clSetKernelArg(r->grad_kernel, 2, sizeof(cl_mem), &r->grad_buf));
+        const size_t global[3] = {(size_t)n[0], (size_t)n[1], (size_t)n[2]};
+        if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS ||
+            (st = umbra__enqueue(ctx, r->grad_kernel, 3, global, NULL, NULL)) != UMBRA_SUCCESS)
+            goto fail;
+        memcpy(r->grad_key, key, sizeof key);
+    }
+    *buf = r->grad_buf;
+    *on = 1;
+fail:
+    if (st != UMBRA_SUCCESS)
+        umbra__release_mem(&r->grad_buf);
+    return st;
 }
 
 /* Sets every argument of the ray caster for a frame into out. */
@@ -598,6 +656,12 @@ static umbra_status bind_raycast(umbra_renderer r, cl_mem out, const char *fn)
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &preint));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof preint_size, &preint_size));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->view_cells_buf));
+    cl_mem grad;
+    cl_uint grad_on;
+    if ((st = gradient_volume(r, &grad, &grad_on)) != UMBRA_SUCCESS)
+        return st;
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &grad));
+    UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof grad_on, &grad_on));
     if (r->tech->bind)
         st = r->tech->bind(r, r->render_kernel, next);
 fail:

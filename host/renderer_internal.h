@@ -178,6 +178,13 @@ struct umbra_renderer_t {
     size_t out_bytes;
     cl_program program;                      /* the ray caster + technique program in use */
     cl_kernel render_kernel, query_kernel;
+    /* The shading gradient volume (kernels/common/sampling.cl, gradient_volume_entry) and its
+     * build kernel, from the ray caster's program: made for shaded frames of a plain whole
+     * volume in one buffer (host/renderer.c, gradient_volume), for the volume id, version and
+     * program in grad_key; released for a frame without shading. */
+    cl_kernel grad_kernel;
+    cl_mem grad_buf;
+    uint64_t grad_key[3];
     size_t render_local[2];                  /* raycast_render's work-group (ensure_kernels) */
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
     /* The view and light transfer functions as the volume's normalised range sees them

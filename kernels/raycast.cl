@@ -36,6 +36,22 @@ UMBRA_INLINE float3 shade_sample(__global const UmbraFrame *F, float3 c, float3 
     return c * (amb + light * F->kd * diff) + light * F->ks * spec;
 }
 
+/* The shading gradient at p: from the gradient volume gv where the host built one (gv_on,
+ * kernels/common/sampling.cl: the same bits as view_gradient), else view_gradient. */
+UMBRA_INLINE float3 ray_gradient(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
+                                 __global const float4 *view_tf, __global const short4 *gv,
+                                 uint gv_on, float3 p)
+{
+#if defined(UMBRA_GRADIENT_VOLUME) && !UMBRA_LABELS && UMBRA_CHANNELS == 1
+    if (gv_on)
+        return gradient_volume_sample(gv, g, p);
+#else
+    (void)gv;
+    (void)gv_on;
+#endif
+    return view_gradient(F, vol, g, view_tf, p);
+}
+
 /* A directional light's direction and half vector for a ray of direction d (shade_sample). */
 inline void shade_ray_light(__global const UmbraFrame *F, float3 d, float3 *l, float3 *hv)
 {
@@ -83,7 +99,8 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                              __global const uchar *view_bricks, __global const ulong *light_cells,
                              __global const UmbraShadow *S, __global float4 *out,
                              __global UMBRA_COUNT_T *samples, __global const float4 *preint,
-                             uint preint_size, __global const ulong *view_cells SHADOW_KERNEL_PARAMS)
+                             uint preint_size, __global const ulong *view_cells,
+                             __global const short4 *grad_vol, uint grad_on SHADOW_KERNEL_PARAMS)
 {
     const int px = get_global_id(0), py = get_global_id(1);
     if (px >= (int)F->width || py >= (int)F->height)
@@ -214,7 +231,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
                                                   : shadow_point(p, d, h, c.w);
                 const float3 s = SHADOW_FACTOR(sr, l_at);
                 const float3 grad = (flags & UMBRA_FLAG_SHADING)
-                                        ? view_gradient(F, vol, g, view_tf, p)
+                                        ? ray_gradient(F, vol, g, view_tf, grad_vol, grad_on, p)
                                         : (float3)(0.0f);
                 color += ((1.0f - alpha) * a) *
                          shade_sample(F, c.xyz, s, p, -d, grad, l_ray, hv_ray);
@@ -289,8 +306,9 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
             }
             if (pending) {
                 float3 s = SHADOW_FACTOR(sr, l_pend);
-                float3 grad = (flags & UMBRA_FLAG_SHADING) ? view_gradient(F, vol, g, view_tf, p_pend)
-                                                            : (float3)(0.0f);
+                float3 grad = (flags & UMBRA_FLAG_SHADING)
+                                  ? ray_gradient(F, vol, g, view_tf, grad_vol, grad_on, p_pend)
+                                  : (float3)(0.0f);
                 float3 lit = shade_sample(F, c_pend.xyz, s, p_pend, -d, grad, l_ray, hv_ray);
                 color += w_pend * lit;
                 pending = 0;
@@ -324,6 +342,24 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
     out[py * (int)F->width + px] = (float4)(color, alpha) + (1.0f - alpha) * bg;
     if (taken)
         UMBRA_COUNT_ADD(samples, taken);
+}
+
+/* Fills the gradient volume (kernels/common/sampling.cl, gradient_volume_entry): one work-item
+ * per entry of the (dims + 3)^3 grid, entry (x, y, z) for q = (x, y, z) - 1. */
+__kernel void raycast_gradient_volume(__global const UmbraFrame *F, VOLUME_PARAM,
+                                      __global short4 *out)
+{
+    const VolGeom g = vol_geom(F);
+    const int3 n = g.dims + 3;
+    const int3 e = (int3)(get_global_id(0), get_global_id(1), get_global_id(2));
+    if (e.x >= n.x || e.y >= n.y || e.z >= n.z)
+        return;
+#if defined(UMBRA_GRADIENT_VOLUME)
+    const size_t at = ((size_t)e.z * (size_t)n.y + (size_t)e.y) * (size_t)n.x + (size_t)e.x;
+    out[at] = gradient_volume_entry(vol, g, e - 1);
+#else
+    (void)out;
+#endif
 }
 
 /* Evaluates the shadow factor at arbitrary world points: for tests, and for applications that

@@ -140,7 +140,12 @@ typedef struct umbra_render_desc {
     float termination;       /* early ray termination once accumulated opacity exceeds this
                                 (default 0.99; 1 disables it) */
     int empty_space_skipping;/* nonzero (default): skip bricks the transfer function makes empty */
-    int shading;             /* nonzero: gradient Blinn-Phong local shading (default 0) */
+    int shading;             /* nonzero: gradient Blinn-Phong local shading (default 0). On a
+                                whole volume of integers (uint8, or 16-bit spanning at most
+                                32767, none outside the value range) the renderer holds a
+                                gradient volume for it: 8 bytes per voxel ((x+3)(y+3)(z+3)
+                                entries), made at the first shaded frame and after a volume
+                                update, freed by an unshaded frame; the image is the same */
     float kd, ks, shininess; /* Blinn-Phong coefficients (defaults 0.8, 0.3, 32) */
     float ambient[3];        /* ambient light (default 0.2 each) */
     float background[4];     /* premultiplied RGBA behind everything (default 0,0,0,0) */

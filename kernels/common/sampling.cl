@@ -418,5 +418,60 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
 #endif
     return (float3)(gx, gy, gz) * (0.5f * slope) * g.inv_spacing;
 }
+
+/* The gradient volume (issue #28): the per-voxel central differences volume_gradient above
+ * interpolates, computed once per volume instead of at every shaded sample (32 voxel loads and
+ * their index arithmetic become 8 loads of 8 bytes at one index). Entry q, q in [-1, dims + 1]
+ * per axis (a grid of dims + 3 per axis, q + 1 x fastest), holds per axis a the difference
+ * v[clamp(q + e_a)] - v[clamp(q - e_a)] of voxel_load values, every index clamped to the grid:
+ * exactly the corner differences of volume_gradient's stencil at the cell whose lowest corner is
+ * q, 0 past the border. They are held as int16, which is exact where the voxels are integers
+ * loaded as stored (uchar, ushort or short without UMBRA_VOXEL_CLAMPS) spanning at most 32767
+ * (the host builds the volume only there), so gradient_volume_sample blends the same floats in
+ * the same order: the same gradient bit for bit. 8 bytes a voxel, built only for shaded frames
+ * and again when the volume changes (host/renderer.c, gradient_volume). Whole volumes in one
+ * buffer only (UMBRA_GRADIENT_VOLUME). */
+#if !UMBRA_PART && !UMBRA_VOXEL_CLAMPS
+#define UMBRA_GRADIENT_VOLUME 1
+inline short4 gradient_volume_entry(VOLUME_PARAM, VolGeom g, int3 q)
+{
+    const int3 top = g.dims - 1;
+    const int3 lo = clamp(q - 1, (int3)(0), top), mid = clamp(q, (int3)(0), top);
+    const int3 hi = clamp(q + 1, (int3)(0), top);
+    const size_t sy = (size_t)g.dims.x, sz = (size_t)g.dims.x * (size_t)g.dims.y;
+    const size_t y = (size_t)mid.y * sy, z = (size_t)mid.z * sz;
+    const float dx = VX(z + y + (size_t)hi.x) - VX(z + y + (size_t)lo.x);
+    const float dy = VX(z + (size_t)hi.y * sy + (size_t)mid.x) - VX(z + (size_t)lo.y * sy + (size_t)mid.x);
+    const float dz = VX((size_t)hi.z * sz + y + (size_t)mid.x) - VX((size_t)lo.z * sz + y + (size_t)mid.x);
+    return convert_short4((float4)(dx, dy, dz, 0.0f));
+}
+
+/* volume_gradient(vol, g, p) from the gradient volume gv. */
+UMBRA_INLINE float3 gradient_volume_sample(__global const short4 *restrict gv, VolGeom g, float3 p)
+{
+    float3 x = clamp(world_to_voxel(g, p), (float3)(-1.0f), convert_float3(g.dims));
+    int3 i = floor_int3(x);
+    float3 f = x - convert_float3(i);
+    const size_t nx = (size_t)g.dims.x + 3, nxy = nx * ((size_t)g.dims.y + 3);
+    const size_t b = (size_t)(i.z + 1) * nxy + (size_t)(i.y + 1) * nx + (size_t)(i.x + 1);
+    /* the cell's corners, named as volume_gradient's: x, y, z each b (i) or c (i + 1) */
+#define GV(i) convert_float4(gv[i])
+    const float4 g_bbb = GV(b), g_cbb = GV(b + 1), g_bcb = GV(b + nx), g_ccb = GV(b + nx + 1);
+    const float4 g_bbc = GV(b + nxy), g_cbc = GV(b + nxy + 1);
+    const float4 g_bcc = GV(b + nxy + nx), g_ccc = GV(b + nxy + nx + 1);
+#undef GV
+    float dx_bb = mix(g_bbb.x, g_cbb.x, f.x), dx_cb = mix(g_bcb.x, g_ccb.x, f.x);
+    float dx_bc = mix(g_bbc.x, g_cbc.x, f.x), dx_cc = mix(g_bcc.x, g_ccc.x, f.x);
+    float gx = mix(mix(dx_bb, dx_cb, f.y), mix(dx_bc, dx_cc, f.y), f.z);
+    float dy_bb = mix(g_bbb.y, g_bcb.y, f.y), dy_cb = mix(g_cbb.y, g_ccb.y, f.y);
+    float dy_bc = mix(g_bbc.y, g_bcc.y, f.y), dy_cc = mix(g_cbc.y, g_ccc.y, f.y);
+    float gy = mix(mix(dy_bb, dy_cb, f.x), mix(dy_bc, dy_cc, f.x), f.z);
+    float dz_bb = mix(g_bbb.z, g_bbc.z, f.z), dz_cb = mix(g_cbb.z, g_cbc.z, f.z);
+    float dz_bc = mix(g_bcb.z, g_bcc.z, f.z), dz_cc = mix(g_ccb.z, g_ccc.z, f.z);
+    float gz = mix(mix(dz_bb, dz_cb, f.x), mix(dz_bc, dz_cc, f.x), f.y);
+    const float slope = g.image_scale * g.value_scale; /* no voxel clamps: stored values */
+    return (float3)(gx, gy, gz) * (0.5f * slope) * g.inv_spacing;
+}
+#endif
 #undef VX
 #endif
