@@ -12,6 +12,8 @@
  *    front of it is lit (factor 1 up to float rounding, 1e-6);
  *  - memory is fixed: map_size^2 x channels x (1 + count) x 4 bytes (1 + count / 2 at 16 bits),
  *    reported, and a camera move re-uses the map;
+ *  - the build's sums: a homogeneous box lit straight down gives every texel the uniform
+ *    measure's moments and the box's optical depth;
  *  - the pre-filter is linear: on the homogeneous slab, whose texels all hold the same record,
  *    a blurred map gives the unblurred factors inside the map;
  *  - count 5, bits 24 are refused naming the parameter (the suite covers the ranges).
@@ -317,6 +319,62 @@ static void test_moments_blur_is_linear(void **state)
     umbra_volume_release(vol);
 }
 
+/* The build's sums: a homogeneous box lit straight down spreads each texel ray's optical depth
+ * evenly over the whole depth, x in [-1, 1], so every stored record holds the uniform measure's
+ * moments, 1 / (k + 1) for even k and 0 for odd k (the segments' exact means, mixed once at the
+ * end of the march, up to float rounding), and b0 the box's optical depth, MT_NY voxels of the
+ * table's extinction. Without the half-width terms of the mix the even moments would be off by
+ * about rad^2 / 3 = 3e-4 (rad = 1 / MT_NY, a step's half-width in x). */
+static void test_moments_homogeneous_gives_uniform_moments(void **state)
+{
+    (void)state;
+    const float alpha = 0.01f; /* per voxel: b0 = 32 (-ln 0.99) = 0.32, under the cap */
+    umbra_volume vol = test_constant_volume(ctx, MT_NX, MT_NY, MT_NZ, 1.0f);
+    umbra_transfer_function tf = mt_tf(ctx, 0.7f, 0.7f, 0.7f, alpha);
+    umbra_renderer r =
+        test_renderer_transmission(ctx, vol, tf, test_directional_light(0, -1, 0),
+                                   UMBRA_TRANSMISSION_GREY);
+    for (uint32_t count = 4; count <= 8; count += 2) {
+        enum { N = 64 };
+        umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_MOMENTS, N, 1);
+        s.moments.count = count;
+        assert_int_equal(umbra_renderer_set_shadow(r, &s), UMBRA_SUCCESS);
+        float p0[3] = {0, 0, 0}, f0[3];
+        assert_int_equal(umbra_renderer_query_shadow(r, p0, 1, f0), UMBRA_SUCCESS);
+        umbra_render_stats st;
+        assert_int_equal(umbra_renderer_get_stats(r, &st), UMBRA_SUCCESS);
+        built b;
+        memset(&b, 0, sizeof b);
+        b.channels = st.light_channels;
+        b.map = malloc(st.shadow_memory_bytes);
+        assert_non_null(b.map);
+        assert_int_equal(umbra__map_read(r, b.map, st.shadow_memory_bytes), UMBRA_SUCCESS);
+        memcpy(&b.P, umbra__map_constants(r), sizeof b.P);
+        const double b0_want = -(double)MT_NY * log1p(-(double)alpha);
+        double worst = 0.0, worst_b0 = 0.0;
+        int checked = 0;
+        for (uint32_t j = N / 4; j < 3 * N / 4; ++j)
+            for (uint32_t i = N / 4; i < 3 * N / 4; ++i) {
+                double mom[UMBRA_MOMENTS_MAX + 1];
+                const double b0 = record(&b, j * N + i, 0, mom);
+                if (!(b0 > 0.0))
+                    continue; /* a ray off the box */
+                ++checked;
+                worst_b0 = fmax(worst_b0, fabs(b0 - b0_want) / b0_want);
+                for (uint32_t k = 1; k <= count; ++k)
+                    worst = fmax(worst, fabs(mom[k] - ((k & 1) ? 0.0 : 1.0 / (k + 1.0))));
+            }
+        assert_true(checked > N * N / 8);
+        if (!(worst <= 2e-5) || !(worst_b0 <= 1e-4))
+            fail_msg("%u moments: largest moment error %g, b0 off by %g of %g", count, worst,
+                     worst_b0, b0_want);
+        free(b.map);
+    }
+    umbra_renderer_release(r);
+    umbra_transfer_function_release(tf);
+    umbra_volume_release(vol);
+}
+
 static void test_moments_bad_count_and_bits_refused_by_name(void **state)
 {
     (void)state;
@@ -344,6 +402,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_moments_bound_holds_against_reference),
         cmocka_unit_test(test_moments_memory_fixed_and_reported),
         cmocka_unit_test(test_moments_blur_is_linear),
+        cmocka_unit_test(test_moments_homogeneous_gives_uniform_moments),
         cmocka_unit_test(test_moments_bad_count_and_bits_refused_by_name),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

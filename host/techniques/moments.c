@@ -12,9 +12,11 @@
 _Static_assert(sizeof(UmbraMoments) == 32, "UmbraMoments layout");
 
 /* The optical depth at which a channel's march stops: a sample behind it keeps at most
- * exp(-12) = 6e-6 of the light, below what a display shows, while the moments then describe only
- * the depth that still matters (the bounds' error scales with the depth they spread). */
-#define DEPTH_CAP 12.0f
+ * exp(-6) = 0.0025 of the light, under one step of an 8-bit display, while the moments then
+ * describe only the depth that still matters (the bounds' error scales with the depth they
+ * spread: against 12, the bonsai's RMSE is a quarter lower and no other bench scene's changes,
+ * docs/moments.md). */
+#define DEPTH_CAP 6.0f
 
 static uint32_t words(const umbra_moments_desc *d)
 {

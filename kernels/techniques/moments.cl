@@ -16,8 +16,10 @@
  * maps' (whole steps of S->step plus a partial one, empty cells skipped); a segment's optical
  * depth is that of its midpoint sample over its length (kernels/common/common.cl, light_depth),
  * taken as spread evenly over the segment's depth interval, whose exact mean of x^k (the
- * binomial sum below, without the cancellation of a difference of powers) it adds. A
- * homogeneous medium therefore gives exactly the moments of the uniform spread over the depths
+ * binomial sum below, without the cancellation of a difference of powers) it adds. The whole
+ * segments share one half-width, so the march adds only od mid^j per segment and channel (mid
+ * the segment's midpoint depth, x affine in the ray parameter) and applies the binomial sum once
+ * at the end (mom_mix). A homogeneous medium therefore gives exactly the moments of the uniform spread over the depths
  * it covers. A channel's march stops once its optical depth reaches P->depth_cap (the segment
  * that passes it is cut where it does): the moments are then those of the measure in front of
  * that point, whose cumulative is the true one up to there, and a sample behind it gets
@@ -144,6 +146,27 @@ UMBRA_INLINE void mom_segment(float mid, float rad, int count, float *e)
     }
 }
 
+/* The march adds, per channel, the sums of od mid^j (j = 0..count, od a segment's optical depth,
+ * mid its depth's midpoint) over the whole segments, whose half-width rad is the same for all of
+ * them: the segments' sum of od e[k] is then sum over i of C(k, 2i) rad^(2i) / (2i + 1) times
+ * the sum of od mid^(k - 2i), mixed once at the end (mom_mix), so a segment costs count
+ * multiply-adds per channel rather than mom_segment's binomial sums. The partial last segment
+ * and the one the cap cuts add their mom_segment means directly. */
+UMBRA_INLINE void mom_mix(float rad, int count, const float *pw, float *sum)
+{
+    float hq[5];
+    const float h2 = rad * rad;
+    float hp = 1.0f;
+    for (int i = 0; i < 5; ++i, hp *= h2)
+        hq[i] = hp / (float)(2 * i + 1);
+    for (int k = 1; k <= count; ++k) {
+        float s = 0.0f;
+        for (int i = 0; 2 * i <= k; ++i)
+            s += mom_binomial_even[k][i] * pw[k - 2 * i] * hq[i];
+        sum[k] += s;
+    }
+}
+
 __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
                             __global const float4 *view_tf, __global const float4 *light_tf,
                             __global const uchar *view_bricks, __global const ulong *light_cells,
@@ -158,17 +181,25 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
     (void)view_bricks;
     const int count = (int)P->count;
     const float cap = P->depth_cap;
-    float tau[UMBRA_LIGHT_CHANNELS], sum[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1];
+    /* tau: the optical depth so far; pw: the whole segments' sums of od mid^j; sum: the
+     * partial segments' sums of od e[k] */
+    float tau[UMBRA_LIGHT_CHANNELS], pw[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1],
+        sum[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1];
     for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
         tau[c] = 0.0f;
         for (int k = 0; k <= UMBRA_MOMENTS_MAX; ++k)
-            sum[c][k] = 0.0f;
+            pw[c][k] = sum[c][k] = 0.0f;
     }
     const VolGeom g = vol_geom(F);
     float3 o, d;
     const float2 tb = ls_texel_ray(S, g, (float2)((float)x + 0.5f, (float)y + 0.5f), &o, &d);
+    /* the warped depth is affine in the ray parameter: x(t) = x_of0 + t x_per_t */
+    const float x_of0 = 2.0f * ls_depth(S, o, 0.0f) - 1.0f;
+    const float x_per_t = 2.0f * S->near_far[2];
+    const float h = S->step;
+    const float rad_full = 0.5f * h * x_per_t;
     if (tb.y > tb.x) {
-        const float h = S->step, h_vox = light_step_voxels(F, S);
+        const float h_vox = light_step_voxels(F, S);
         const uint n_tf = F->light_tf_size, flags = F->flags;
         const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
         const float len = tb.y - tb.x;
@@ -183,14 +214,15 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
             if (!(seg > 0.0f))
                 break;
             const float t_start = tb.x + (float)k * h;
-            const float4 col =
-                light_sample(F, vol, g, light_tf, n_tf, o + (t_start + 0.5f * seg) * d);
+            const float t_mid = t_start + 0.5f * seg;
+            const float4 col = light_sample(F, vol, g, light_tf, n_tf, o + t_mid * d);
             if (col.w > 0.0f) {
                 const light_t od = light_depth(col, h_vox * (seg / h), flags);
-                const float xa = 2.0f * ls_depth(S, o, t_start) - 1.0f;
-                const float xb = 2.0f * ls_depth(S, o, t_start + seg) - 1.0f;
-                float e[UMBRA_MOMENTS_MAX + 1];
-                mom_segment(0.5f * (xa + xb), 0.5f * (xb - xa), count, e);
+                const float mid = x_of0 + t_mid * x_per_t, rad = 0.5f * seg * x_per_t;
+                float mp[UMBRA_MOMENTS_MAX + 1];
+                mp[0] = 1.0f;
+                for (int i = 1; i <= count; ++i)
+                    mp[i] = mp[i - 1] * mid;
                 int going = 0;
                 for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
                     const float odc = MOM_CH(od, c);
@@ -198,8 +230,15 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
                         continue;
                     if (tau[c] + odc < cap) {
                         tau[c] += odc;
-                        for (int i = 1; i <= count; ++i)
-                            sum[c][i] += odc * e[i];
+                        if (k < n_full) {
+                            for (int i = 0; i <= count; ++i)
+                                pw[c][i] += odc * mp[i];
+                        } else { /* the partial last segment */
+                            float e[UMBRA_MOMENTS_MAX + 1];
+                            mom_segment(mid, rad, count, e);
+                            for (int i = 1; i <= count; ++i)
+                                sum[c][i] += odc * e[i];
+                        }
                         ++going;
                         continue;
                     }
@@ -207,7 +246,7 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
                      * at the segment's density. */
                     const float part = cap - tau[c], f = part / odc;
                     float ec[UMBRA_MOMENTS_MAX + 1];
-                    mom_segment(xa + 0.5f * f * (xb - xa), 0.5f * f * (xb - xa), count, ec);
+                    mom_segment(mid - rad + f * rad, f * rad, count, ec);
                     for (int i = 1; i <= count; ++i)
                         sum[c][i] += part * ec[i];
                     tau[c] = cap;
@@ -221,6 +260,7 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
     const size_t texel = ((size_t)y * (size_t)n + (size_t)x) * UMBRA_LIGHT_CHANNELS;
     for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
         float m[UMBRA_MOMENTS_MAX + 1];
+        mom_mix(rad_full, count, pw[c], sum[c]);
         const float inv = tau[c] > 0.0f ? 1.0f / tau[c] : 0.0f;
         for (int k = 1; k <= count; ++k)
             m[k] = clamp(sum[c][k] * inv, -1.0f, 1.0f);
