@@ -138,12 +138,12 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
                            "%s: technique %s does not split into parts: its slices carry the light "
                            "over the whole view depth", fn, tech);
     case UMBRA_SHADOW_THRESHOLD: /* after its exchange: render_part checks */
-        break;
     case UMBRA_SHADOW_CSSM:
+        break;
     case UMBRA_SHADOW_DEEP:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is not part-aware yet: its light exchange is not "
-                           "implemented (none and threshold render on a part)", fn, tech);
+                           "implemented (none, threshold and cssm render on a part)", fn, tech);
     default:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is refused on a part: its light structure has no "
@@ -212,6 +212,12 @@ umbra_status umbra_renderer_part_rect(umbra_renderer r, uint32_t width, uint32_t
     return UMBRA_SUCCESS;
 }
 
+/* The techniques whose part marches the light and exchanges depths: threshold and CSSM. */
+static int exchanges_depths(umbra_shadow_technique t)
+{
+    return t == UMBRA_SHADOW_THRESHOLD || t == UMBRA_SHADOW_CSSM;
+}
+
 static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t height,
                                 umbra_part_rect *rect_out, float *rgba)
 {
@@ -227,14 +233,14 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     /* A light build now (if its inputs changed) would overwrite the imported depths. */
-    if (r->shadow_set.technique == UMBRA_SHADOW_THRESHOLD) {
+    if (exchanges_depths(r->shadow_set.technique)) {
         if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
             return st;
         if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: technique threshold: import the depths of all parts "
+                               "%s: technique %s: import the depths of all parts "
                                "(umbra_renderer_part_import_depths) after the last light build",
-                               fn);
+                               fn, umbra_shadow_technique_name(r->shadow_set.technique));
     }
     umbra__frame_update_light(r);
     umbra__frame_update_view(r, width, height);
@@ -286,23 +292,68 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
  * and the optical depth tau (kernels/techniques/threshold.cl). */
 #define STATE_FLOATS 2u
 
+/* The march state per technique: floats per texel, the light's (a part first on its ray), and
+ * the depths' floats per texel. Threshold: (P, tau), (1, 0), one depth. CSSM: the optical depth
+ * per simulated light channel (kernels/techniques/cssm.cl), 0, a depth per channel (r->channels,
+ * set by umbra__frame_update_light). */
+static uint32_t state_floats(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : STATE_FLOATS;
+}
+
+static uint32_t depth_floats(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : 1u;
+}
+
+static void state_start(umbra_renderer r, float *state, size_t floats)
+{
+    const int cssm = r->shadow_set.technique == UMBRA_SHADOW_CSSM;
+    for (size_t i = 0; i < floats; ++i)
+        state[i] = cssm || i % STATE_FLOATS ? 0.0f : 1.0f;
+}
+
+/* An imported state's first bad texel, refused naming it and its value. */
+static umbra_status state_check(umbra_renderer r, const char *fn, const float *s, uint32_t n)
+{
+    const size_t floats = (size_t)n * n * state_floats(r);
+    if (r->shadow_set.technique == UMBRA_SHADOW_CSSM) {
+        const uint32_t ch = r->channels;
+        for (size_t i = 0; i < floats; ++i)
+            if (!(s[i] >= 0.0f))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: texel %zu (%zu, %zu): optical depth %g of channel %zu "
+                                   "must be >= 0 (cssm's state: one per light channel)",
+                                   fn, i / ch, i / ch % n, i / ch / n, s[i], i % ch);
+        return UMBRA_SUCCESS;
+    }
+    for (size_t i = 0; i < floats; i += STATE_FLOATS)
+        if (!(s[i] >= 0.0f && s[i] <= 1.0f) || !(s[i + 1] >= 0.0f))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
+                               "transmittance product in [0, 1] and an optical depth >= 0",
+                               fn, i / STATE_FLOATS, i / STATE_FLOATS % n, i / STATE_FLOATS / n,
+                               s[i], s[i + 1]);
+    return UMBRA_SUCCESS;
+}
+
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
     const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
     return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
-                       "%s: technique %s has no light exchange between parts (none and threshold "
-                       "have)", fn, tech ? tech : "?");
+                       "%s: technique %s has no light exchange between parts (none, threshold "
+                       "and cssm have)", fn, tech ? tech : "?");
 }
 
 /* The light inputs brought up to date and the map size chosen, for a part whose technique
- * exchanges light (threshold). */
+ * exchanges light (threshold, CSSM). */
 static umbra_status light_ready(umbra_renderer r, const char *fn, uint32_t *map_size)
 {
     if (!r->volume || !r->volume->is_part || !r->tf)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: set a part volume (umbra_volume_create_part) and a transfer "
                            "function first", fn);
-    if (r->shadow_set.technique != UMBRA_SHADOW_THRESHOLD)
+    if (!exchanges_depths(r->shadow_set.technique))
         return light_unsupported(r, fn);
     umbra_status st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
@@ -318,7 +369,7 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const size_t floats = (size_t)n * n * STATE_FLOATS, bytes = floats * sizeof(float);
+    const size_t floats = (size_t)n * n * state_floats(r), bytes = floats * sizeof(float);
     if (r->part_state_in && r->part_state_floats != floats)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_render_part: the imported transmittance holds %zu "
@@ -330,10 +381,7 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
         if (!(init = malloc(bytes)))
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
                                "umbra_renderer_render_part");
-        for (size_t i = 0; i < floats; i += STATE_FLOATS) {
-            init[i] = 1.0f;
-            init[i + 1] = 0.0f;
-        }
+        state_start(r, init, floats);
         src = init;
     }
     size_t have = 0;
@@ -371,10 +419,10 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
         return st;
     out->kind = UMBRA_PART_LIGHT_TAU_DEPTH;
     out->map_size = n;
-    out->channels = STATE_FLOATS;
-    out->depth_channels = 1;
-    out->tau_floats = (size_t)n * n * STATE_FLOATS;
-    out->depth_floats = (size_t)n * n;
+    out->channels = state_floats(r);
+    out->depth_channels = depth_floats(r);
+    out->tau_floats = (size_t)n * n * out->channels;
+    out->depth_floats = (size_t)n * n * out->depth_channels;
     return UMBRA_SUCCESS;
 }
 
@@ -404,13 +452,13 @@ static umbra_status export_light(umbra_renderer r, const char *fn, float *out, i
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto fail;
     if (depths) {
-        st = umbra__map_read(r, out, (size_t)n * n * sizeof(float));
+        st = umbra__map_read(r, out, (size_t)n * n * depth_floats(r) * sizeof(float));
     } else if (!r->part_state_buf) {
         st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: no march state was built", fn);
     } else {
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
-                                     (size_t)n * n * STATE_FLOATS * sizeof(float), out, 0, NULL,
-                                     NULL));
+                                     (size_t)n * n * state_floats(r) * sizeof(float), out, 0,
+                                     NULL, NULL));
     }
 fail:
     umbra__call_end(r);
@@ -431,16 +479,11 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
     umbra_status st = light_ready(r, fn, &n);
     if (st != UMBRA_SUCCESS)
         return st;
-    const size_t floats = (size_t)n * n * STATE_FLOATS;
+    const size_t floats = (size_t)n * n * state_floats(r);
     float *copy = NULL;
     if (tau_in) {
-        for (size_t i = 0; i < floats; i += STATE_FLOATS)
-            if (!(tau_in[i] >= 0.0f && tau_in[i] <= 1.0f) || !(tau_in[i + 1] >= 0.0f))
-                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                   "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
-                                   "transmittance product in [0, 1] and an optical depth >= 0",
-                                   fn, i / STATE_FLOATS, i / STATE_FLOATS % n,
-                                   i / STATE_FLOATS / n, tau_in[i], tau_in[i + 1]);
+        if ((st = state_check(r, fn, tau_in, n)) != UMBRA_SUCCESS)
+            return st;
         if (!(copy = malloc(floats * sizeof *copy)))
             return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
         memcpy(copy, tau_in, floats * sizeof *copy);
@@ -471,13 +514,15 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         return st;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto done;
-    for (size_t i = 0; i < (size_t)n * n; ++i)
+    const size_t ch = depth_floats(r);
+    for (size_t i = 0; i < (size_t)n * n * ch; ++i)
         if (isnan(depths[i])) {
             st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                             "%s: texel %zu (%zu, %zu): the depth is NaN", fn, i, i % n, i / n);
+                             "%s: texel %zu (%zu, %zu): the depth is NaN", fn, i / ch,
+                             i / ch % n, i / ch / n);
             goto done;
         }
-    if ((st = umbra__map_write(r, depths, (size_t)n * n * sizeof(float))) == UMBRA_SUCCESS) {
+    if ((st = umbra__map_write(r, depths, (size_t)n * n * ch * sizeof(float))) == UMBRA_SUCCESS) {
         r->part_depths_at = r->rebuilds.shadow;
         r->part_depths_valid = 1;
     }

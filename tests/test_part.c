@@ -279,13 +279,13 @@ static float compare_split(umbra_context ctx, const float *voxels, umbra_transfe
 
 static const uint32_t CX[] = {16}, CY[] = {24}, CZ[] = {16};
 
-/* The threshold map on parts: each part's march goes on from the state the part before it on the
- * light's rays left (imported, exported, in light order), the depths reduce by a minimum, and
- * every part renders with the minimum. Returns the image's largest difference and counts the
- * depths that differ from one device's map in *differing. */
-static float compare_threshold(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
-                               const scene *s, const uint32_t ncuts[3], int extra_empty,
-                               size_t *differing)
+/* The threshold map or CSSM on parts: each part's march goes on from the state the part before
+ * it on the light's rays left (imported, exported, in light order), the depths reduce by a
+ * minimum, and every part renders with the minimum. Returns the image's largest difference and
+ * counts the depths that differ from one device's map in *differing. */
+static float compare_map(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
+                         const scene *s, const uint32_t ncuts[3], int extra_empty,
+                         umbra_shadow_technique technique, size_t *differing)
 {
     const uint32_t *const cuts[3] = {CX, CY, CZ};
     umbra_part_desc parts[16];
@@ -293,8 +293,12 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
                                   parts);
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
-    sd.technique = UMBRA_SHADOW_THRESHOLD;
+    sd.technique = technique;
     sd.map.size = 96;
+    /* CSSM simulates three channels with coloured transmission (the scene's light transfer
+     * function is not grey), one otherwise; the threshold map one depth and a state of two. */
+    const int cssm = technique == UMBRA_SHADOW_CSSM;
+    const uint32_t ch = cssm && s->opts.transmission == UMBRA_TRANSMISSION_COLORED ? 3u : 1u;
 
     /* One device. */
     umbra_volume_desc d;
@@ -304,10 +308,10 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     umbra_renderer whole_r = scene_renderer(ctx, whole_v, tf, s);
     assert_int_equal(umbra_renderer_set_shadow(whole_r, &sd), UMBRA_SUCCESS);
     float *whole = test_render_image(whole_r, W, H);
-    const size_t texels = (size_t)sd.map.size * sd.map.size;
-    float *whole_map = malloc(texels * sizeof *whole_map);
+    const size_t texels = (size_t)sd.map.size * sd.map.size, values = texels * ch;
+    float *whole_map = malloc(values * sizeof *whole_map);
     assert_non_null(whole_map);
-    assert_int_equal(umbra__map_read(whole_r, whole_map, texels * sizeof *whole_map),
+    assert_int_equal(umbra__map_read(whole_r, whole_map, values * sizeof *whole_map),
                      UMBRA_SUCCESS);
 
     /* The parts. */
@@ -334,6 +338,9 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     assert_int_equal(umbra_renderer_part_light_info(rs[0], &li), UMBRA_SUCCESS);
     assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
     assert_int_equal(li.map_size, sd.map.size);
+    assert_int_equal(li.channels, cssm ? ch : 2u);
+    assert_int_equal(li.depth_channels, ch);
+    assert_int_equal(li.depth_floats, values);
     float *state = malloc(li.tau_floats * sizeof *state);
     float *depth = malloc(li.depth_floats * sizeof *depth);
     float *acc = malloc(li.depth_floats * sizeof *acc);
@@ -357,7 +364,7 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
         umbra_part_minimum(acc, depth, li.depth_floats);
     }
     *differing = 0;
-    for (size_t t = 0; t < texels; ++t)
+    for (size_t t = 0; t < values; ++t)
         *differing += memcmp(&acc[t], &whole_map[t], sizeof acc[t]) != 0;
     float *frame = calloc((size_t)W * H * 4, sizeof *frame);
     float *img = malloc((size_t)W * H * 4 * sizeof *img);
@@ -373,11 +380,17 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     }
     umbra_part_background(frame, (size_t)W * H, s->opts.background);
     const float diff = test_max_diff(whole, frame, (size_t)W * H * 4, NULL);
-    /* The map holds shadow: some texel has a depth. */
-    size_t hit = 0;
-    for (size_t t = 0; t < texels; ++t)
+    /* The map holds shadow: some texel has a depth; with three channels, some texel's channels
+     * stopped their photons at different depths (the colour is simulated, not one channel
+     * copied). */
+    size_t hit = 0, coloured = 0;
+    for (size_t t = 0; t < values; ++t)
         hit += isfinite(whole_map[t]) && whole_map[t] < 1.5f;
+    for (size_t t = 0; ch == 3 && t < texels; ++t)
+        coloured += whole_map[3 * t] != whole_map[3 * t + 1] ||
+                    whole_map[3 * t + 1] != whole_map[3 * t + 2];
     assert_true(hit > 10);
+    assert_true(ch == 1 || coloured > 10);
     for (uint32_t i = 0; i < n; ++i) {
         umbra_renderer_release(rs[i]);
         umbra_volume_release(vols[i]);
@@ -407,8 +420,42 @@ static void test_threshold_splits_match_one_device(void **state)
         const scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
         for (int k = 0; k < 4; ++k) {
             size_t differing = 0;
-            float d = compare_threshold(ctx, voxels, tf, &s, splits[k], k == 3, &differing);
+            float d = compare_map(ctx, voxels, tf, &s, splits[k], k == 3, UMBRA_SHADOW_THRESHOLD,
+                                  &differing);
             printf("threshold case %zu split %d: max |diff| %.3g, %zu differing depths\n", c, k,
+                   (double)d, differing);
+            assert_int_equal(differing, 0);
+            assert_true(d <= PART_BOUND);
+        }
+    }
+    umbra_transfer_function_release(tf);
+    free(voxels);
+}
+
+/* CSSM on parts: the optical depth per light channel passed on in light order, the photons an
+ * earlier part stopped skipped, the stored depths reduced by a minimum: the map equals one
+ * device's depth for depth, the image within PART_BOUND. Grey and coloured transmission (three
+ * channels), a directional light along an axis and oblique, a point light inside and outside. */
+static void test_cssm_splits_match_one_device(void **state)
+{
+    umbra_context ctx = *state;
+    float *voxels = scene_voxels();
+    umbra_transfer_function tf = scene_tf(ctx);
+    const uint32_t split_2x1x1[3] = {1, 0, 0}, split_2x2x1[3] = {1, 1, 0},
+                   split_2x2x2[3] = {1, 1, 1};
+    const uint32_t *splits[] = {split_2x1x1, split_2x2x1, split_2x2x2, split_2x1x1};
+    /* ortho, jitter, shading, point (1 inside, 2 outside), coloured */
+    const int cases[][5] = {{0, 0, 0, 0, 0}, {0, 0, 1, 0, 1}, {0, 1, 1, 1, 1},
+                            {1, 0, 1, 0, 1}, {1, 1, 0, 2, 0}, {1, 0, 0, 0, 0}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
+        if (cases[c][4])
+            s.opts.transmission = UMBRA_TRANSMISSION_COLORED;
+        for (int k = 0; k < 4; ++k) {
+            size_t differing = 0;
+            float d = compare_map(ctx, voxels, tf, &s, splits[k], k == 3, UMBRA_SHADOW_CSSM,
+                                  &differing);
+            printf("cssm case %zu split %d: max |diff| %.3g, %zu differing depths\n", c, k,
                    (double)d, differing);
             assert_int_equal(differing, 0);
             assert_true(d <= PART_BOUND);
@@ -635,7 +682,6 @@ static void test_bad_input_refused(void **state)
     } refused[] = {{UMBRA_SHADOW_REFERENCE, "technique reference does not split"},
                    {UMBRA_SHADOW_CONVOLUTION, "technique convolution does not split"},
                    {UMBRA_SHADOW_MOMENTS, "technique moments is refused on a part"},
-                   {UMBRA_SHADOW_CSSM, "technique cssm is not part-aware"},
                    {UMBRA_SHADOW_DEEP, "technique deep is not part-aware"}};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i) {
         umbra_shadow_desc sd;
@@ -678,6 +724,31 @@ static void test_bad_input_refused(void **state)
         free(dep);
         free(st);
     }
+    /* CSSM's state is an optical depth per channel: a negative one or NaN is refused naming the
+     * texel. */
+    {
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_CSSM;
+        sd.map.size = 64;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "technique cssm: import the depths",
+                           NULL);
+        umbra_part_light_info li = {.struct_size = sizeof li};
+        assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
+        assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
+        assert_int_equal(li.channels, 1);
+        float *st = calloc(li.tau_floats, sizeof *st);
+        assert_non_null(st);
+        st[9] = -0.25f;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, st),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 9 (9, 0)", "-0.25");
+        st[9] = NAN;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, st),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 9 (9, 0)", "nan");
+        free(st);
+    }
     /* A whole volume is not a part. */
     umbra_renderer_release(r);
     umbra_volume w = test_volume(ctx, NX, NY, NZ, voxels);
@@ -704,6 +775,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_splits_match_one_device),
         cmocka_unit_test(test_termination_bound),
         cmocka_unit_test(test_threshold_splits_match_one_device),
+        cmocka_unit_test(test_cssm_splits_match_one_device),
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
