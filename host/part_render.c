@@ -47,6 +47,8 @@ void umbra__part_frame(umbra_renderer r, int view)
     F->flags &= ~UMBRA_FLAG_SKIP_EMPTY;
     if (view)
         memset(F->background, 0, sizeof F->background);
+    if (view && r->part_front)
+        F->flags |= UMBRA_FLAG_PART_FRONT;
 }
 
 /* The rectangle of the width x height image the core box's corners project to, grown by a pixel
@@ -218,18 +220,38 @@ static int exchanges_depths(umbra_shadow_technique t)
     return t == UMBRA_SHADOW_THRESHOLD || t == UMBRA_SHADOW_CSSM;
 }
 
-static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t height,
-                                umbra_part_rect *rect_out, float *rgba)
+/* The front state of the frame's rectangle refused naming the first bad pixel: an opacity
+ * outside [0, 1] or a NaN. */
+static umbra_status check_front(umbra_renderer r, const char *fn, const float *frame,
+                                uint32_t width, const umbra_part_rect *rect)
 {
-    const char *fn = "umbra_renderer_render_part";
+    for (uint32_t y = rect->y; y < rect->y + rect->height; ++y)
+        for (uint32_t x = rect->x; x < rect->x + rect->width; ++x) {
+            const float *p = frame + ((size_t)y * width + x) * 4;
+            if (!(p[3] >= 0.0f && p[3] <= 1.0f) || isnan(p[0]) || isnan(p[1]) || isnan(p[2]))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: frame pixel (%u, %u): (%g, %g, %g, %g) must have an "
+                                   "opacity in [0, 1] and no NaN (premultiplied RGBA of the "
+                                   "parts in front)", fn, x, y, p[0], p[1], p[2], p[3]);
+        }
+    return UMBRA_SUCCESS;
+}
+
+/* out receives the rectangle's partial image (into 0), or the width x height frame out's
+ * rectangle goes on from the accumulation in it and is written back (into 1). */
+static umbra_status render_part(umbra_renderer r, const char *fn, uint32_t width, uint32_t height,
+                                umbra_part_rect *rect_out, float *out, int into)
+{
+    float *rgba = into ? NULL : out, *frame = into ? out : NULL;
     umbra_context ctx = r->ctx;
     umbra_status st = umbra__check_size(r, width, height, fn);
     if (st == UMBRA_SUCCESS)
         st = check_part_render(r, fn);
     if (st != UMBRA_SUCCESS)
         return st;
-    if (!rgba)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: %s is NULL", fn,
+                           into ? "frame" : "rgba");
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     /* A light build now (if its inputs changed) would overwrite the imported depths. */
@@ -258,17 +280,31 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
     if ((st = umbra__ensure_buffer(r, &r->out_buf, bytes, CL_MEM_READ_WRITE)) != UMBRA_SUCCESS)
         return st;
     r->out_bytes = bytes;
-    r->part_call = 1;
-    st = umbra__render_into(r, width, height, r->out_buf);
-    r->part_call = 0;
-    if (st != UMBRA_SUCCESS)
-        return st;
     const size_t px = 4 * sizeof(float);
     const size_t origin[3] = {rect.x * px, rect.y, 0};
     const size_t region[3] = {rect.width * px, rect.height, 1};
-    UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, (size_t[3]){0, 0, 0},
-                                     region, width * px, 0, rect.width * px, 0, rgba, 0, NULL,
-                                     NULL));
+    if (frame) {
+        /* The rays of the rectangle go on from the front state (kernels/raycast.cl). */
+        if ((st = check_front(r, fn, frame, width, &rect)) != UMBRA_SUCCESS)
+            return st;
+        UMBRA_CL(clEnqueueWriteBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, origin,
+                                          region, width * px, 0, width * px, 0, frame, 0, NULL,
+                                          NULL));
+    }
+    r->part_call = 1;
+    r->part_front = frame != NULL;
+    st = umbra__render_into(r, width, height, r->out_buf);
+    r->part_call = 0;
+    r->part_front = 0;
+    if (st != UMBRA_SUCCESS)
+        return st;
+    if (frame)
+        UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, origin, region,
+                                         width * px, 0, width * px, 0, frame, 0, NULL, NULL));
+    else
+        UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin,
+                                         (size_t[3]){0, 0, 0}, region, width * px, 0,
+                                         rect.width * px, 0, rgba, 0, NULL, NULL));
     umbra__progress_end(r);
 fail:
     return st;
@@ -280,7 +316,19 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
     CHECK_R();
     umbra_status st = umbra__call_begin(r, __func__);
     if (st == UMBRA_SUCCESS) {
-        st = render_part(r, width, height, rect, rgba);
+        st = render_part(r, __func__, width, height, rect, rgba, 0);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
+umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width, uint32_t height,
+                                             umbra_part_rect *rect, float *frame)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_part(r, __func__, width, height, rect, frame, 1);
         umbra__call_end(r);
     }
     return st;

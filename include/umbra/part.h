@@ -117,6 +117,22 @@ UMBRA_API umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t wid
                                                   uint32_t height, umbra_part_rect *rect,
                                                   float *rgba);
 
+/* The part's samples added to the accumulation of the parts in front of it, as one device's ray
+ * adds them: frame is the width x height image (premultiplied float RGBA, row 0 at the top, no
+ * background) the parts before this one in view order (umbra_part_view_order) rendered into,
+ * starting from 0; the pixels of the part's rectangle (*rect, as umbra_renderer_part_rect sets
+ * it; NULL: not reported) go on from its colour and opacity, front to back, and are written back;
+ * the others are left as they are. After the last part, umbra_part_background gives one device's
+ * image bit for bit (the same sums in the same order; early ray termination included: a ray
+ * ended in front takes no sample here), where umbra_renderer_render_part's partial images,
+ * composited with the over operator, round differently (docs/distributed.md). The price: each
+ * part waits for the ones in front of it. A pixel of the rectangle with an opacity outside
+ * [0, 1] or a NaN is refused with UMBRA_ERROR_INVALID_ARGUMENT naming it; otherwise as
+ * umbra_renderer_render_part. */
+UMBRA_API umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width,
+                                                       uint32_t height, umbra_part_rect *rect,
+                                                       float *frame);
+
 /* What crosses parts along the light for the renderer's technique, in light order. The threshold
  * map and CSSM exchange light (UMBRA_PART_LIGHT_TAU_DEPTH); the deep map is refused by name for
  * now, and its kind says what it will export and import. */
@@ -225,7 +241,7 @@ UMBRA_API umbra_status umbra_part_composite(float *frame, uint32_t width, uint32
 UMBRA_API void umbra_part_over(const float *front, const float *back, float *out, size_t count);
 
 /* Puts a composited image over the background as one device does: C + (1 - a) background, for
- * count pixels. */
+ * count pixels, one fused multiply-add per channel as the ray caster's (the same rounding). */
 UMBRA_API void umbra_part_background(float *rgba, size_t count, const float background[4]);
 
 /* acc[i] *= t[i] for count floats: one step of the prefix product of exit transmittances in
