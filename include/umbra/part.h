@@ -39,7 +39,8 @@
  *
  * Early ray termination acts within a part's own segment: with termination below 1 a part
  * behind another still adds what one device would have dropped (at most 1 - termination of the
- * pixel); parts equal one device when termination is 1. */
+ * pixel); parts equal one device when termination is 1. Rendered part after part into one frame
+ * (umbra_renderer_render_part_into) a ray ends where one device's ends, at any termination. */
 #ifndef UMBRA_PART_H
 #define UMBRA_PART_H
 
