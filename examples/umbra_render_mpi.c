@@ -29,10 +29,12 @@ enum { OPT_GRID, OPT_COMPOSITE };
 static const program_option mpi_option_list[] = {
     [OPT_GRID] = {"grid", "PXxPYxPZ", "parts per axis, one per rank: their product is the "
                                       "number of ranks (required)"},
-    [OPT_COMPOSITE] = {"composite", "reduce-scatter|sequential",
+    [OPT_COMPOSITE] = {"composite", "reduce-scatter|sequential|chain",
                        "how the partial images compose: MPI_Reduce_scatter_block with the over "
-                       "operator (default), or all gathered at rank 0 and composited front to "
-                       "back there"},
+                       "operator (default), all gathered at rank 0 and composited front to back "
+                       "there, or one frame passed down the ranks in view order, each going on "
+                       "from the ones in front (one device's image bit for bit; the renders run "
+                       "one after the other)"},
 };
 
 static int mpi_take(void *user, size_t index, const char *v)
@@ -53,12 +55,14 @@ static int mpi_take(void *user, size_t index, const char *v)
         o->have_grid = 1;
         return 0;
     }
-    if (strcmp(v, "reduce-scatter") != 0 && strcmp(v, "sequential") != 0) {
-        fprintf(stderr, "umbra-render-mpi: --composite '%s' is not reduce-scatter or "
-                        "sequential\n", v);
+    if (strcmp(v, "reduce-scatter") != 0 && strcmp(v, "sequential") != 0 &&
+        strcmp(v, "chain") != 0) {
+        fprintf(stderr, "umbra-render-mpi: --composite '%s' is not reduce-scatter, sequential "
+                        "or chain\n", v);
         return 1;
     }
     o->mode = strcmp(v, "sequential") == 0 ? UMBRA_MPI_COMPOSITE_SEQUENTIAL
+              : strcmp(v, "chain") == 0    ? UMBRA_MPI_COMPOSITE_CHAIN
                                            : UMBRA_MPI_COMPOSITE_REDUCE_SCATTER;
     return 0;
 }

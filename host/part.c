@@ -292,7 +292,7 @@ void umbra_part_background(float *rgba, size_t count, const float bg[4])
         float *p = rgba + 4 * i;
         const float t = 1.0f - p[3];
         for (int c = 0; c < 4; ++c)
-            p[c] = p[c] + t * bg[c];
+            p[c] = fmaf(t, bg[c], p[c]); /* as kernels/raycast.cl: the same rounding */
     }
 }
 

@@ -47,6 +47,8 @@ void umbra__part_frame(umbra_renderer r, int view)
     F->flags &= ~UMBRA_FLAG_SKIP_EMPTY;
     if (view)
         memset(F->background, 0, sizeof F->background);
+    if (view && r->part_front)
+        F->flags |= UMBRA_FLAG_PART_FRONT;
 }
 
 /* The rectangle of the width x height image the core box's corners project to, grown by a pixel
@@ -138,12 +140,12 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
                            "%s: technique %s does not split into parts: its slices carry the light "
                            "over the whole view depth", fn, tech);
     case UMBRA_SHADOW_THRESHOLD: /* after its exchange: render_part checks */
-        break;
     case UMBRA_SHADOW_CSSM:
+        break;
     case UMBRA_SHADOW_DEEP:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is not part-aware yet: its light exchange is not "
-                           "implemented (none and threshold render on a part)", fn, tech);
+                           "implemented (none, threshold and cssm render on a part)", fn, tech);
     default:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is refused on a part: its light structure has no "
@@ -212,29 +214,55 @@ umbra_status umbra_renderer_part_rect(umbra_renderer r, uint32_t width, uint32_t
     return UMBRA_SUCCESS;
 }
 
-static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t height,
-                                umbra_part_rect *rect_out, float *rgba)
+/* The techniques whose part marches the light and exchanges depths: threshold and CSSM. */
+static int exchanges_depths(umbra_shadow_technique t)
 {
-    const char *fn = "umbra_renderer_render_part";
+    return t == UMBRA_SHADOW_THRESHOLD || t == UMBRA_SHADOW_CSSM;
+}
+
+/* The front state of the frame's rectangle refused naming the first bad pixel: an opacity
+ * outside [0, 1] or a NaN. */
+static umbra_status check_front(umbra_renderer r, const char *fn, const float *frame,
+                                uint32_t width, const umbra_part_rect *rect)
+{
+    for (uint32_t y = rect->y; y < rect->y + rect->height; ++y)
+        for (uint32_t x = rect->x; x < rect->x + rect->width; ++x) {
+            const float *p = frame + ((size_t)y * width + x) * 4;
+            if (!(p[3] >= 0.0f && p[3] <= 1.0f) || isnan(p[0]) || isnan(p[1]) || isnan(p[2]))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: frame pixel (%u, %u): (%g, %g, %g, %g) must have an "
+                                   "opacity in [0, 1] and no NaN (premultiplied RGBA of the "
+                                   "parts in front)", fn, x, y, p[0], p[1], p[2], p[3]);
+        }
+    return UMBRA_SUCCESS;
+}
+
+/* out receives the rectangle's partial image (into 0), or the width x height frame out's
+ * rectangle goes on from the accumulation in it and is written back (into 1). */
+static umbra_status render_part(umbra_renderer r, const char *fn, uint32_t width, uint32_t height,
+                                umbra_part_rect *rect_out, float *out, int into)
+{
+    float *rgba = into ? NULL : out, *frame = into ? out : NULL;
     umbra_context ctx = r->ctx;
     umbra_status st = umbra__check_size(r, width, height, fn);
     if (st == UMBRA_SUCCESS)
         st = check_part_render(r, fn);
     if (st != UMBRA_SUCCESS)
         return st;
-    if (!rgba)
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
+    if (!out)
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: %s is NULL", fn,
+                           into ? "frame" : "rgba");
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
     /* A light build now (if its inputs changed) would overwrite the imported depths. */
-    if (r->shadow_set.technique == UMBRA_SHADOW_THRESHOLD) {
+    if (exchanges_depths(r->shadow_set.technique)) {
         if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
             return st;
         if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: technique threshold: import the depths of all parts "
+                               "%s: technique %s: import the depths of all parts "
                                "(umbra_renderer_part_import_depths) after the last light build",
-                               fn);
+                               fn, umbra_shadow_technique_name(r->shadow_set.technique));
     }
     umbra__frame_update_light(r);
     umbra__frame_update_view(r, width, height);
@@ -252,17 +280,31 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
     if ((st = umbra__ensure_buffer(r, &r->out_buf, bytes, CL_MEM_READ_WRITE)) != UMBRA_SUCCESS)
         return st;
     r->out_bytes = bytes;
-    r->part_call = 1;
-    st = umbra__render_into(r, width, height, r->out_buf);
-    r->part_call = 0;
-    if (st != UMBRA_SUCCESS)
-        return st;
     const size_t px = 4 * sizeof(float);
     const size_t origin[3] = {rect.x * px, rect.y, 0};
     const size_t region[3] = {rect.width * px, rect.height, 1};
-    UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, (size_t[3]){0, 0, 0},
-                                     region, width * px, 0, rect.width * px, 0, rgba, 0, NULL,
-                                     NULL));
+    if (frame) {
+        /* The rays of the rectangle go on from the front state (kernels/raycast.cl). */
+        if ((st = check_front(r, fn, frame, width, &rect)) != UMBRA_SUCCESS)
+            return st;
+        UMBRA_CL(clEnqueueWriteBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, origin,
+                                          region, width * px, 0, width * px, 0, frame, 0, NULL,
+                                          NULL));
+    }
+    r->part_call = 1;
+    r->part_front = frame != NULL;
+    st = umbra__render_into(r, width, height, r->out_buf);
+    r->part_call = 0;
+    r->part_front = 0;
+    if (st != UMBRA_SUCCESS)
+        return st;
+    if (frame)
+        UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin, origin, region,
+                                         width * px, 0, width * px, 0, frame, 0, NULL, NULL));
+    else
+        UMBRA_CL(clEnqueueReadBufferRect(ctx->queue, r->out_buf, CL_TRUE, origin,
+                                         (size_t[3]){0, 0, 0}, region, width * px, 0,
+                                         rect.width * px, 0, rgba, 0, NULL, NULL));
     umbra__progress_end(r);
 fail:
     return st;
@@ -274,7 +316,19 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
     CHECK_R();
     umbra_status st = umbra__call_begin(r, __func__);
     if (st == UMBRA_SUCCESS) {
-        st = render_part(r, width, height, rect, rgba);
+        st = render_part(r, __func__, width, height, rect, rgba, 0);
+        umbra__call_end(r);
+    }
+    return st;
+}
+
+umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width, uint32_t height,
+                                             umbra_part_rect *rect, float *frame)
+{
+    CHECK_R();
+    umbra_status st = umbra__call_begin(r, __func__);
+    if (st == UMBRA_SUCCESS) {
+        st = render_part(r, __func__, width, height, rect, frame, 1);
         umbra__call_end(r);
     }
     return st;
@@ -286,23 +340,68 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
  * and the optical depth tau (kernels/techniques/threshold.cl). */
 #define STATE_FLOATS 2u
 
+/* The march state per technique: floats per texel, the light's (a part first on its ray), and
+ * the depths' floats per texel. Threshold: (P, tau), (1, 0), one depth. CSSM: the optical depth
+ * per simulated light channel (kernels/techniques/cssm.cl), 0, a depth per channel (r->channels,
+ * set by umbra__frame_update_light). */
+static uint32_t state_floats(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : STATE_FLOATS;
+}
+
+static uint32_t depth_floats(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : 1u;
+}
+
+static void state_start(umbra_renderer r, float *state, size_t floats)
+{
+    const int cssm = r->shadow_set.technique == UMBRA_SHADOW_CSSM;
+    for (size_t i = 0; i < floats; ++i)
+        state[i] = cssm || i % STATE_FLOATS ? 0.0f : 1.0f;
+}
+
+/* An imported state's first bad texel, refused naming it and its value. */
+static umbra_status state_check(umbra_renderer r, const char *fn, const float *s, uint32_t n)
+{
+    const size_t floats = (size_t)n * n * state_floats(r);
+    if (r->shadow_set.technique == UMBRA_SHADOW_CSSM) {
+        const uint32_t ch = r->channels;
+        for (size_t i = 0; i < floats; ++i)
+            if (!(s[i] >= 0.0f))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: texel %zu (%zu, %zu): optical depth %g of channel %zu "
+                                   "must be >= 0 (cssm's state: one per light channel)",
+                                   fn, i / ch, i / ch % n, i / ch / n, s[i], i % ch);
+        return UMBRA_SUCCESS;
+    }
+    for (size_t i = 0; i < floats; i += STATE_FLOATS)
+        if (!(s[i] >= 0.0f && s[i] <= 1.0f) || !(s[i + 1] >= 0.0f))
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
+                               "transmittance product in [0, 1] and an optical depth >= 0",
+                               fn, i / STATE_FLOATS, i / STATE_FLOATS % n, i / STATE_FLOATS / n,
+                               s[i], s[i + 1]);
+    return UMBRA_SUCCESS;
+}
+
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
     const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
     return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
-                       "%s: technique %s has no light exchange between parts (none and threshold "
-                       "have)", fn, tech ? tech : "?");
+                       "%s: technique %s has no light exchange between parts (none, threshold "
+                       "and cssm have)", fn, tech ? tech : "?");
 }
 
 /* The light inputs brought up to date and the map size chosen, for a part whose technique
- * exchanges light (threshold). */
+ * exchanges light (threshold, CSSM). */
 static umbra_status light_ready(umbra_renderer r, const char *fn, uint32_t *map_size)
 {
     if (!r->volume || !r->volume->is_part || !r->tf)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: set a part volume (umbra_volume_create_part) and a transfer "
                            "function first", fn);
-    if (r->shadow_set.technique != UMBRA_SHADOW_THRESHOLD)
+    if (!exchanges_depths(r->shadow_set.technique))
         return light_unsupported(r, fn);
     umbra_status st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
@@ -318,7 +417,7 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const size_t floats = (size_t)n * n * STATE_FLOATS, bytes = floats * sizeof(float);
+    const size_t floats = (size_t)n * n * state_floats(r), bytes = floats * sizeof(float);
     if (r->part_state_in && r->part_state_floats != floats)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_render_part: the imported transmittance holds %zu "
@@ -330,10 +429,7 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
         if (!(init = malloc(bytes)))
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
                                "umbra_renderer_render_part");
-        for (size_t i = 0; i < floats; i += STATE_FLOATS) {
-            init[i] = 1.0f;
-            init[i + 1] = 0.0f;
-        }
+        state_start(r, init, floats);
         src = init;
     }
     size_t have = 0;
@@ -371,10 +467,10 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
         return st;
     out->kind = UMBRA_PART_LIGHT_TAU_DEPTH;
     out->map_size = n;
-    out->channels = STATE_FLOATS;
-    out->depth_channels = 1;
-    out->tau_floats = (size_t)n * n * STATE_FLOATS;
-    out->depth_floats = (size_t)n * n;
+    out->channels = state_floats(r);
+    out->depth_channels = depth_floats(r);
+    out->tau_floats = (size_t)n * n * out->channels;
+    out->depth_floats = (size_t)n * n * out->depth_channels;
     return UMBRA_SUCCESS;
 }
 
@@ -404,13 +500,13 @@ static umbra_status export_light(umbra_renderer r, const char *fn, float *out, i
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto fail;
     if (depths) {
-        st = umbra__map_read(r, out, (size_t)n * n * sizeof(float));
+        st = umbra__map_read(r, out, (size_t)n * n * depth_floats(r) * sizeof(float));
     } else if (!r->part_state_buf) {
         st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: no march state was built", fn);
     } else {
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
-                                     (size_t)n * n * STATE_FLOATS * sizeof(float), out, 0, NULL,
-                                     NULL));
+                                     (size_t)n * n * state_floats(r) * sizeof(float), out, 0,
+                                     NULL, NULL));
     }
 fail:
     umbra__call_end(r);
@@ -431,16 +527,11 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
     umbra_status st = light_ready(r, fn, &n);
     if (st != UMBRA_SUCCESS)
         return st;
-    const size_t floats = (size_t)n * n * STATE_FLOATS;
+    const size_t floats = (size_t)n * n * state_floats(r);
     float *copy = NULL;
     if (tau_in) {
-        for (size_t i = 0; i < floats; i += STATE_FLOATS)
-            if (!(tau_in[i] >= 0.0f && tau_in[i] <= 1.0f) || !(tau_in[i + 1] >= 0.0f))
-                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                   "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
-                                   "transmittance product in [0, 1] and an optical depth >= 0",
-                                   fn, i / STATE_FLOATS, i / STATE_FLOATS % n,
-                                   i / STATE_FLOATS / n, tau_in[i], tau_in[i + 1]);
+        if ((st = state_check(r, fn, tau_in, n)) != UMBRA_SUCCESS)
+            return st;
         if (!(copy = malloc(floats * sizeof *copy)))
             return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
         memcpy(copy, tau_in, floats * sizeof *copy);
@@ -471,13 +562,15 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         return st;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto done;
-    for (size_t i = 0; i < (size_t)n * n; ++i)
+    const size_t ch = depth_floats(r);
+    for (size_t i = 0; i < (size_t)n * n * ch; ++i)
         if (isnan(depths[i])) {
             st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                             "%s: texel %zu (%zu, %zu): the depth is NaN", fn, i, i % n, i / n);
+                             "%s: texel %zu (%zu, %zu): the depth is NaN", fn, i / ch,
+                             i / ch % n, i / ch / n);
             goto done;
         }
-    if ((st = umbra__map_write(r, depths, (size_t)n * n * sizeof(float))) == UMBRA_SUCCESS) {
+    if ((st = umbra__map_write(r, depths, (size_t)n * n * ch * sizeof(float))) == UMBRA_SUCCESS) {
         r->part_depths_at = r->rebuilds.shadow;
         r->part_depths_valid = 1;
     }

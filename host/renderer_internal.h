@@ -209,6 +209,7 @@ struct umbra_renderer_t {
     umbra_render_stats stats;
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
     int part_call;                           /* umbra_renderer_render_part is rendering */
+    int part_front;                          /* ... going on from the front state in out_buf */
     /* A part's light exchange (host/part_render.c): the march state imported (host, NULL: none
      * yet), its device copy the build reads and writes, and the shadow build count at the last
      * import of depths. */

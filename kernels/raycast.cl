@@ -127,6 +127,15 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
 
     float3 color = (float3)(0.0f);
     float alpha = 0.0f;
+#if UMBRA_PART
+    /* A part rendered after the parts in front of it (umbra_renderer_render_part_into) goes on
+     * from the colour and opacity they accumulated: one device's running sum, bit for bit. */
+    if (flags & UMBRA_FLAG_PART_FRONT) {
+        const float4 front = out[py * (int)F->width + px];
+        color = front.xyz;
+        alpha = front.w;
+    }
+#endif
     uint taken = 0;
     ShadowRay sr;
     shadow_ray_init(&sr);
@@ -247,7 +256,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
             const float3 lo = fmax(F3(F->part_lo), 0.0f) - 1.0f;
             const float3 hi = fmin(F3(F->part_hi), dims) + 1.0f;
             const float2 pb = ray_box(o, d, g.box_min + lo * g.spacing, g.box_min + hi * g.spacing);
-            if (!(pb.y >= pb.x))
+            if (!(pb.y >= pb.x) || alpha > termination) /* missed, or ended in front */
                 k = n;
             else if (pb.x > t0)
                 k = max(k, (int)floor((pb.x - t0) / h - jitter) - 1);
@@ -339,7 +348,10 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
         alpha = 1.0f;
     }
     float4 bg = vload4(0, F->background);
-    out[py * (int)F->width + px] = (float4)(color, alpha) + (1.0f - alpha) * bg;
+    /* An explicit fma, correctly rounded on every device (a compiler may or may not contract
+     * the product and sum): umbra_part_background (host/part.c) does the same with fmaf, so a
+     * frame rendered part after part over the background is one device's image bit for bit. */
+    out[py * (int)F->width + px] = fma((float4)(1.0f - alpha), bg, (float4)(color, alpha));
     if (taken)
         UMBRA_COUNT_ADD(samples, taken);
 }

@@ -10,9 +10,13 @@
  *    along an axis, jitter on and off, shading on and off, grey and coloured light, directional
  *    along an axis and oblique, a point light inside and outside the box;
  *  - with early ray termination (0.9) the difference is at most 1 - termination;
- *  - the threshold map on parts: the march state passed on in light order
- *    (umbra_part_visibility_order from the light), the depths reduced by umbra_part_minimum:
- *    the map equals one device's depth for depth (0 differing), the image within PART_BOUND;
+ *  - the threshold map and CSSM (grey and coloured transmission) on parts: the march state
+ *    passed on in light order (umbra_part_visibility_order from the light), the depths reduced
+ *    by umbra_part_minimum: the map equals one device's depth for depth (0 differing), the image
+ *    within PART_BOUND;
+ *  - the same parts rendered one after another into one frame, each going on from the
+ *    accumulation of the parts in front (umbra_renderer_render_part_into): one device's image bit
+ *    for bit (memcmp) for none (termination 1 and 0.9), the threshold map and CSSM;
  *  - the host helpers: the visibility order of a 2x2x2 grid from a point and along a direction,
  *    the over operator, the product and minimum;
  *  - bad input, refused naming the value, the context usable after: an offset off the brick
@@ -20,7 +24,9 @@
  *    too few ghost layers, the techniques that do not split (reference, convolution) and those
  *    not yet part-aware, the ground plane, a projection mode, a part rendered with
  *    umbra_renderer_render, a threshold part rendered before its depths were imported or after
- *    the light changed, a NaN depth and a transmittance above 1 (each naming the texel).
+ *    the light changed, a NaN depth and a transmittance above 1 (each naming the texel), CSSM's
+ *    negative or NaN optical depth (naming the texel), a front opacity above 1 (naming the
+ *    pixel).
  * Usage: test_part [filter] (a cmocka test-name glob). */
 #include <math.h>
 #include <stdio.h>
@@ -200,16 +206,46 @@ static uint32_t make_parts(const uint32_t *const cuts[3], const uint32_t ncuts[3
     return n;
 }
 
-/* Renders every part, composites in view order, puts the background under it. */
+/* Counts the floats of a and b whose bits differ. */
+static size_t bits_differing(const float *a, const float *b, size_t count)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < count; ++i)
+        n += memcmp(&a[i], &b[i], sizeof a[i]) != 0;
+    return n;
+}
+
+/* Renders every part in view order into one frame, each going on from the accumulation of the
+ * parts in front (umbra_renderer_render_part_into), and puts the background under it. */
+static float *render_into_frame(const scene *s, umbra_renderer *rs, const uint32_t *order,
+                                uint32_t n)
+{
+    float *frame = calloc((size_t)W * H * 4, sizeof *frame);
+    assert_non_null(frame);
+    for (uint32_t i = 0; i < n; ++i) {
+        umbra_part_rect rect, want;
+        assert_int_equal(umbra_renderer_render_part_into(rs[order[i]], W, H, &rect, frame),
+                         UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_rect(rs[order[i]], W, H, &want), UMBRA_SUCCESS);
+        assert_memory_equal(&rect, &want, sizeof rect);
+    }
+    umbra_part_background(frame, (size_t)W * H, s->opts.background);
+    return frame;
+}
+
+/* Renders every part, composites in view order, puts the background under it; *seq gets the
+ * frame rendered part after part into one accumulation (render_into_frame). */
 static float *render_parts(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
-                           const scene *s, const umbra_part_desc *parts, uint32_t n)
+                           const scene *s, const umbra_part_desc *parts, uint32_t n, float **seq)
 {
     float *frame = calloc((size_t)W * H * 4, sizeof *frame);
     float *part_img = malloc((size_t)W * H * 4 * sizeof *part_img);
     umbra_part_rect *rects = calloc(n, sizeof *rects);
     float **imgs = calloc(n, sizeof *imgs);
     uint32_t *order = calloc(n, sizeof *order);
-    assert_true(frame && part_img && rects && imgs && order);
+    umbra_renderer *rs = calloc(n, sizeof *rs);
+    umbra_volume *vs = calloc(n, sizeof *vs);
+    assert_true(frame && part_img && rects && imgs && order && rs && vs);
     umbra_volume_info info;
     memset(&info, 0, sizeof info);
     for (uint32_t i = 0; i < n; ++i) {
@@ -240,16 +276,22 @@ static float *render_parts(umbra_context ctx, const float *voxels, umbra_transfe
             assert_int_equal(rects[i].width * rects[i].height, 0);
         imgs[i] = malloc((size_t)rects[i].width * rects[i].height * 4 * sizeof(float) + 1);
         memcpy(imgs[i], part_img, (size_t)rects[i].width * rects[i].height * 4 * sizeof(float));
-        umbra_renderer_release(r);
-        umbra_volume_release(v);
+        rs[i] = r;
+        vs[i] = v;
     }
     assert_int_equal(umbra_part_view_order(parts, n, &info, &s->camera, order), UMBRA_SUCCESS);
     for (uint32_t i = 0; i < n; ++i)
         assert_int_equal(umbra_part_composite(frame, W, H, imgs[order[i]], &rects[order[i]]),
                          UMBRA_SUCCESS);
     umbra_part_background(frame, (size_t)W * H, s->opts.background);
-    for (uint32_t i = 0; i < n; ++i)
+    *seq = render_into_frame(s, rs, order, n);
+    for (uint32_t i = 0; i < n; ++i) {
         free(imgs[i]);
+        umbra_renderer_release(rs[i]);
+        umbra_volume_release(vs[i]);
+    }
+    free(rs);
+    free(vs);
     free(imgs);
     free(rects);
     free(order);
@@ -257,16 +299,21 @@ static float *render_parts(umbra_context ctx, const float *voxels, umbra_transfe
     return frame;
 }
 
+/* The composited image's largest difference from one device's; *seq_differing counts the floats
+ * of the image rendered part after part into one accumulation that differ from it in any bit. */
 static float compare_split(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
                            const scene *s, const uint32_t *const cuts[3], const uint32_t ncuts[3],
-                           int extra_empty)
+                           int extra_empty, size_t *seq_differing)
 {
     umbra_part_desc parts[16];
     const uint32_t n =
         make_parts(cuts, ncuts, extra_empty, umbra_part_ghost_needed(&s->opts), parts);
     float *whole = render_whole(ctx, voxels, tf, s);
-    float *split = render_parts(ctx, voxels, tf, s, parts, n);
+    float *seq = NULL;
+    float *split = render_parts(ctx, voxels, tf, s, parts, n, &seq);
     float diff = test_max_diff(whole, split, (size_t)W * H * 4, NULL);
+    *seq_differing = bits_differing(whole, seq, (size_t)W * H * 4);
+    free(seq);
     /* The volume is in the image: a wrong split could not pass by showing nothing. */
     double lit = 0.0;
     for (size_t i = 0; i < (size_t)W * H; ++i)
@@ -279,13 +326,14 @@ static float compare_split(umbra_context ctx, const float *voxels, umbra_transfe
 
 static const uint32_t CX[] = {16}, CY[] = {24}, CZ[] = {16};
 
-/* The threshold map on parts: each part's march goes on from the state the part before it on the
- * light's rays left (imported, exported, in light order), the depths reduce by a minimum, and
- * every part renders with the minimum. Returns the image's largest difference and counts the
- * depths that differ from one device's map in *differing. */
-static float compare_threshold(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
-                               const scene *s, const uint32_t ncuts[3], int extra_empty,
-                               size_t *differing)
+/* The threshold map or CSSM on parts: each part's march goes on from the state the part before
+ * it on the light's rays left (imported, exported, in light order), the depths reduce by a
+ * minimum, and every part renders with the minimum. Returns the image's largest difference and
+ * counts the depths that differ from one device's map in *differing. */
+static float compare_map(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
+                         const scene *s, const uint32_t ncuts[3], int extra_empty,
+                         umbra_shadow_technique technique, size_t *differing,
+                         size_t *seq_differing)
 {
     const uint32_t *const cuts[3] = {CX, CY, CZ};
     umbra_part_desc parts[16];
@@ -293,8 +341,12 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
                                   parts);
     umbra_shadow_desc sd;
     umbra_shadow_desc_init(&sd);
-    sd.technique = UMBRA_SHADOW_THRESHOLD;
+    sd.technique = technique;
     sd.map.size = 96;
+    /* CSSM simulates three channels with coloured transmission (the scene's light transfer
+     * function is not grey), one otherwise; the threshold map one depth and a state of two. */
+    const int cssm = technique == UMBRA_SHADOW_CSSM;
+    const uint32_t ch = cssm && s->opts.transmission == UMBRA_TRANSMISSION_COLORED ? 3u : 1u;
 
     /* One device. */
     umbra_volume_desc d;
@@ -304,10 +356,10 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     umbra_renderer whole_r = scene_renderer(ctx, whole_v, tf, s);
     assert_int_equal(umbra_renderer_set_shadow(whole_r, &sd), UMBRA_SUCCESS);
     float *whole = test_render_image(whole_r, W, H);
-    const size_t texels = (size_t)sd.map.size * sd.map.size;
-    float *whole_map = malloc(texels * sizeof *whole_map);
+    const size_t texels = (size_t)sd.map.size * sd.map.size, values = texels * ch;
+    float *whole_map = malloc(values * sizeof *whole_map);
     assert_non_null(whole_map);
-    assert_int_equal(umbra__map_read(whole_r, whole_map, texels * sizeof *whole_map),
+    assert_int_equal(umbra__map_read(whole_r, whole_map, values * sizeof *whole_map),
                      UMBRA_SUCCESS);
 
     /* The parts. */
@@ -334,6 +386,9 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     assert_int_equal(umbra_renderer_part_light_info(rs[0], &li), UMBRA_SUCCESS);
     assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
     assert_int_equal(li.map_size, sd.map.size);
+    assert_int_equal(li.channels, cssm ? ch : 2u);
+    assert_int_equal(li.depth_channels, ch);
+    assert_int_equal(li.depth_floats, values);
     float *state = malloc(li.tau_floats * sizeof *state);
     float *depth = malloc(li.depth_floats * sizeof *depth);
     float *acc = malloc(li.depth_floats * sizeof *acc);
@@ -357,7 +412,7 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
         umbra_part_minimum(acc, depth, li.depth_floats);
     }
     *differing = 0;
-    for (size_t t = 0; t < texels; ++t)
+    for (size_t t = 0; t < values; ++t)
         *differing += memcmp(&acc[t], &whole_map[t], sizeof acc[t]) != 0;
     float *frame = calloc((size_t)W * H * 4, sizeof *frame);
     float *img = malloc((size_t)W * H * 4 * sizeof *img);
@@ -373,11 +428,20 @@ static float compare_threshold(umbra_context ctx, const float *voxels, umbra_tra
     }
     umbra_part_background(frame, (size_t)W * H, s->opts.background);
     const float diff = test_max_diff(whole, frame, (size_t)W * H * 4, NULL);
-    /* The map holds shadow: some texel has a depth. */
-    size_t hit = 0;
-    for (size_t t = 0; t < texels; ++t)
+    float *seq = render_into_frame(s, rs, order, n);
+    *seq_differing = bits_differing(whole, seq, (size_t)W * H * 4);
+    free(seq);
+    /* The map holds shadow: some texel has a depth; with three channels, some texel's channels
+     * stopped their photons at different depths (the colour is simulated, not one channel
+     * copied). */
+    size_t hit = 0, coloured = 0;
+    for (size_t t = 0; t < values; ++t)
         hit += isfinite(whole_map[t]) && whole_map[t] < 1.5f;
+    for (size_t t = 0; ch == 3 && t < texels; ++t)
+        coloured += whole_map[3 * t] != whole_map[3 * t + 1] ||
+                    whole_map[3 * t + 1] != whole_map[3 * t + 2];
     assert_true(hit > 10);
+    assert_true(ch == 1 || coloured > 10);
     for (uint32_t i = 0; i < n; ++i) {
         umbra_renderer_release(rs[i]);
         umbra_volume_release(vols[i]);
@@ -406,12 +470,48 @@ static void test_threshold_splits_match_one_device(void **state)
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         const scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
         for (int k = 0; k < 4; ++k) {
-            size_t differing = 0;
-            float d = compare_threshold(ctx, voxels, tf, &s, splits[k], k == 3, &differing);
-            printf("threshold case %zu split %d: max |diff| %.3g, %zu differing depths\n", c, k,
-                   (double)d, differing);
+            size_t differing = 0, seq = 0;
+            float d = compare_map(ctx, voxels, tf, &s, splits[k], k == 3, UMBRA_SHADOW_THRESHOLD,
+                                  &differing, &seq);
+            printf("threshold case %zu split %d: max |diff| %.3g, %zu differing depths; part "
+                   "after part: %zu floats differ\n", c, k, (double)d, differing, seq);
             assert_int_equal(differing, 0);
             assert_true(d <= PART_BOUND);
+            assert_int_equal(seq, 0);
+        }
+    }
+    umbra_transfer_function_release(tf);
+    free(voxels);
+}
+
+/* CSSM on parts: the optical depth per light channel passed on in light order, the photons an
+ * earlier part stopped skipped, the stored depths reduced by a minimum: the map equals one
+ * device's depth for depth, the image within PART_BOUND. Grey and coloured transmission (three
+ * channels), a directional light along an axis and oblique, a point light inside and outside. */
+static void test_cssm_splits_match_one_device(void **state)
+{
+    umbra_context ctx = *state;
+    float *voxels = scene_voxels();
+    umbra_transfer_function tf = scene_tf(ctx);
+    const uint32_t split_2x1x1[3] = {1, 0, 0}, split_2x2x1[3] = {1, 1, 0},
+                   split_2x2x2[3] = {1, 1, 1};
+    const uint32_t *splits[] = {split_2x1x1, split_2x2x1, split_2x2x2, split_2x1x1};
+    /* ortho, jitter, shading, point (1 inside, 2 outside), coloured */
+    const int cases[][5] = {{0, 0, 0, 0, 0}, {0, 0, 1, 0, 1}, {0, 1, 1, 1, 1},
+                            {1, 0, 1, 0, 1}, {1, 1, 0, 2, 0}, {1, 0, 0, 0, 0}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
+        if (cases[c][4])
+            s.opts.transmission = UMBRA_TRANSMISSION_COLORED;
+        for (int k = 0; k < 4; ++k) {
+            size_t differing = 0, seq = 0;
+            float d = compare_map(ctx, voxels, tf, &s, splits[k], k == 3, UMBRA_SHADOW_CSSM,
+                                  &differing, &seq);
+            printf("cssm case %zu split %d: max |diff| %.3g, %zu differing depths; part after "
+                   "part: %zu floats differ\n", c, k, (double)d, differing, seq);
+            assert_int_equal(differing, 0);
+            assert_true(d <= PART_BOUND);
+            assert_int_equal(seq, 0);
         }
     }
     umbra_transfer_function_release(tf);
@@ -434,11 +534,14 @@ static void test_splits_match_one_device(void **state)
         const scene s = make_scene(cases[c][0], cases[c][1], cases[c][2], cases[c][3], cases[c][4]);
         const uint32_t *splits[] = {split_2x1x1, split_2x2x1, split_2x2x2, split_2x1x1};
         for (int k = 0; k < 4; ++k) {
-            float d = compare_split(ctx, voxels, tf, &s, cuts, splits[k], k == 3);
-            printf("case %zu split %d: max |diff| %.3g\n", c, k, (double)d);
+            size_t seq = 0;
+            float d = compare_split(ctx, voxels, tf, &s, cuts, splits[k], k == 3, &seq);
+            printf("case %zu split %d: max |diff| %.3g; part after part: %zu floats differ\n", c,
+                   k, (double)d, seq);
             if (d > worst)
                 worst = d;
             assert_true(d <= PART_BOUND);
+            assert_int_equal(seq, 0);
         }
     }
     printf("largest difference over all splits and cases: %.3g (bound %.3g)\n", (double)worst,
@@ -457,9 +560,13 @@ static void test_termination_bound(void **state)
     const uint32_t split[3] = {1, 1, 1};
     scene s = make_scene(0, 1, 0, 0, 0);
     s.opts.termination = 0.9f;
-    float d = compare_split(ctx, voxels, tf, &s, cuts, split, 0);
-    printf("termination 0.9: max |diff| %.3g\n", (double)d);
+    size_t seq = 0;
+    float d = compare_split(ctx, voxels, tf, &s, cuts, split, 0, &seq);
+    printf("termination 0.9: max |diff| %.3g; part after part: %zu floats differ\n", (double)d,
+           seq);
     assert_true(d <= 1.0f - s.opts.termination + PART_BOUND);
+    /* A part after the others goes on from their opacity, so it ends where one device ends. */
+    assert_int_equal(seq, 0);
     umbra_transfer_function_release(tf);
     free(voxels);
 }
@@ -635,7 +742,6 @@ static void test_bad_input_refused(void **state)
     } refused[] = {{UMBRA_SHADOW_REFERENCE, "technique reference does not split"},
                    {UMBRA_SHADOW_CONVOLUTION, "technique convolution does not split"},
                    {UMBRA_SHADOW_MOMENTS, "technique moments is refused on a part"},
-                   {UMBRA_SHADOW_CSSM, "technique cssm is not part-aware"},
                    {UMBRA_SHADOW_DEEP, "technique deep is not part-aware"}};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i) {
         umbra_shadow_desc sd;
@@ -678,6 +784,49 @@ static void test_bad_input_refused(void **state)
         free(dep);
         free(st);
     }
+    /* CSSM's state is an optical depth per channel: a negative one or NaN is refused naming the
+     * texel. */
+    {
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_CSSM;
+        sd.map.size = 64;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "technique cssm: import the depths",
+                           NULL);
+        umbra_part_light_info li = {.struct_size = sizeof li};
+        assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
+        assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
+        assert_int_equal(li.channels, 1);
+        float *st = calloc(li.tau_floats, sizeof *st);
+        assert_non_null(st);
+        st[9] = -0.25f;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, st),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 9 (9, 0)", "-0.25");
+        st[9] = NAN;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, st),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 9 (9, 0)", "nan");
+        free(st);
+    }
+    /* A frame to go on from with an opacity above 1 in the part's rectangle, naming the pixel. */
+    {
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        float *frame = calloc((size_t)W * H * 4, sizeof *frame);
+        assert_non_null(frame);
+        assert_int_equal(umbra_renderer_part_rect(r, W, H, &rect), UMBRA_SUCCESS);
+        assert_true(rect.width > 1 && rect.height > 1);
+        char where[64];
+        snprintf(where, sizeof where, "frame pixel (%u, %u)", rect.x + 1, rect.y + 1);
+        frame[((size_t)(rect.y + 1) * W + rect.x + 1) * 4 + 3] = 1.5f;
+        test_assert_failed(ctx, umbra_renderer_render_part_into(r, W, H, &rect, frame),
+                           UMBRA_ERROR_INVALID_ARGUMENT, where, "opacity in [0, 1]");
+        test_assert_failed(ctx, umbra_renderer_render_part_into(r, W, H, &rect, NULL),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "frame is NULL", NULL);
+        free(frame);
+    }
     /* A whole volume is not a part. */
     umbra_renderer_release(r);
     umbra_volume w = test_volume(ctx, NX, NY, NZ, voxels);
@@ -704,6 +853,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_splits_match_one_device),
         cmocka_unit_test(test_termination_bound),
         cmocka_unit_test(test_threshold_splits_match_one_device),
+        cmocka_unit_test(test_cssm_splits_match_one_device),
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);

@@ -6,7 +6,10 @@
  * enter. Only MPI's own collectives move data: MPI_Exscan and MPI_Allreduce for the light,
  * MPI_Reduce_scatter_block with a non-commutative MPI_Op for the view (the operands of a
  * non-commutative reduction are combined in rank order, so the ranks of the communicator are put
- * in view order first), MPI_Gather(v) to collect at the root. */
+ * in view order first), MPI_Gather(v) to collect at the root. Two chains pass data from rank to
+ * rank in light or view order instead (MPI_Send, MPI_Recv), where each step needs the one before:
+ * the threshold and CSSM march state (umbra_mpi_light) and the frame of
+ * UMBRA_MPI_COMPOSITE_CHAIN (render_chain). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <limits.h>
@@ -533,8 +536,15 @@ umbra_status umbra_mpi_composite(MPI_Comm ordered, umbra_context ctx, const floa
     MPI_Comm_size(ordered, &size);
     const size_t block = (pixels + (size_t)size - 1) / (size_t)size;
 
-    if (!rect || (rect->width && rect->height && !part) || (me == root && !image) || width == 0 ||
-        height == 0 || root < 0 || root >= size)
+    if (mode == UMBRA_MPI_COMPOSITE_CHAIN)
+        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                  "umbra_mpi_composite: mode chain renders while it composites: use "
+                  "umbra_mpi_render");
+    else if (mode != UMBRA_MPI_COMPOSITE_REDUCE_SCATTER && mode != UMBRA_MPI_COMPOSITE_SEQUENTIAL)
+        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_composite: mode %d is unknown",
+                  (int)mode);
+    else if (!rect || (rect->width && rect->height && !part) || (me == root && !image) ||
+             width == 0 || height == 0 || root < 0 || root >= size)
         st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                                         "umbra_mpi_composite: image %u x %u, root %d of %d ranks, "
                                         "or a NULL rect, part or image at the root",
@@ -637,12 +647,120 @@ fail:
     return st;
 }
 
+/* UMBRA_MPI_COMPOSITE_CHAIN: the frame goes down the ranks in view order, each adding its
+ * part's samples to the accumulation of the parts in front (umbra_renderer_render_part_into),
+ * then to root, which puts the background under it: one device's image bit for bit. The renders
+ * run one after the other (a rank waits for the ones in front of it), as the light chain of
+ * umbra_mpi_light does; a rank that fails passes its status on with the frame, and the agreement
+ * at the end reports the first failure. */
+static umbra_status render_chain(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
+                                 umbra_volume volume, const umbra_camera *camera, uint32_t width,
+                                 uint32_t height, const float background[4], int root,
+                                 float *image, umbra_mpi_stats *stats)
+{
+    umbra_part_desc part, *all = NULL;
+    umbra_volume_info placement;
+    uint32_t *order = NULL;
+    float *frame = NULL, flag = 0.0f;
+    MPI_Comm ordered = MPI_COMM_NULL;
+    int count = 0, me = 0, pos = 0, size = 1, oroot = -1;
+    const size_t floats = (size_t)width * height * 4;
+    umbra_status st;
+
+    MPI_Comm_rank(comm, &me);
+    MPI_Comm_size(comm, &size);
+    umbra_part_desc_init(&part);
+    st = camera ? umbra_volume_get_part(volume, &part)
+                : fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: camera is NULL");
+    if (st == UMBRA_SUCCESS && (root < 0 || root >= size))
+        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: root %d of %d ranks",
+                  root, size);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_volume_get_info(volume, &placement);
+    if (st == UMBRA_SUCCESS && (width == 0 || height == 0 || floats > INT_MAX))
+        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                  "umbra_mpi_render: chain composite of a %u x %u image: it must be non-empty "
+                  "and within MPI's int counts (%zu floats)", width, height, floats);
+    if (st == UMBRA_SUCCESS && me == root && !image)
+        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: image is NULL at root");
+    if (st == UMBRA_SUCCESS && !(frame = malloc(floats * sizeof *frame)))
+        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                  "umbra_mpi_render: cannot allocate a %u x %u frame", width, height);
+    st = agree(comm, ctx, st);
+    if (st == UMBRA_SUCCESS)
+        st = gather_parts(comm, ctx, &part, &all, &count);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    order = malloc((size_t)count * sizeof *order);
+    st = order ? umbra_part_view_order(all, (uint32_t)count, &placement, camera, order)
+               : UMBRA_ERROR_OUT_OF_MEMORY;
+    st = agree(comm, ctx, st);
+    if (st == UMBRA_SUCCESS)
+        st = split_in_order(comm, ctx, order, count, &ordered);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    for (int i = 0; i < count; ++i)
+        if (order[i] == (uint32_t)root)
+            oroot = i;
+    MPI_Comm_rank(ordered, &pos);
+    MPI_Comm_size(ordered, &size);
+
+    double t = now_ms();
+    if (pos == 0) {
+        memset(frame, 0, floats * sizeof *frame);
+    } else {
+        MPI_Recv(frame, (int)floats, MPI_FLOAT, pos - 1, 0, ordered, MPI_STATUS_IGNORE);
+        MPI_Recv(&flag, 1, MPI_FLOAT, pos - 1, 1, ordered, MPI_STATUS_IGNORE);
+        if (flag != 0.0f)
+            st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                      "umbra_mpi_render: a rank before this one in view order failed");
+    }
+    if (stats)
+        stats->composite_ms += now_ms() - t;
+    t = now_ms();
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_render_part_into(r, width, height, NULL, frame);
+    if (stats)
+        stats->render_ms += now_ms() - t;
+    t = now_ms();
+    flag = st == UMBRA_SUCCESS ? 0.0f : 1.0f;
+    const int next = pos + 1 < size ? pos + 1 : oroot; /* the last rank hands it to root */
+    if (next != pos) {
+        MPI_Send(frame, (int)floats, MPI_FLOAT, next, 0, ordered);
+        MPI_Send(&flag, 1, MPI_FLOAT, next, 1, ordered);
+        if (stats)
+            stats->bytes_sent += floats * sizeof *frame + sizeof flag;
+    }
+    if (pos == oroot && pos != size - 1) {
+        MPI_Recv(frame, (int)floats, MPI_FLOAT, size - 1, 0, ordered, MPI_STATUS_IGNORE);
+        MPI_Recv(&flag, 1, MPI_FLOAT, size - 1, 1, ordered, MPI_STATUS_IGNORE);
+    }
+    if (pos == oroot && st == UMBRA_SUCCESS && flag == 0.0f) {
+        umbra_part_background(frame, (size_t)width * height, background ? background
+                                                                        : (const float[4]){0});
+        memcpy(image, frame, floats * sizeof *image);
+    }
+    if (stats)
+        stats->composite_ms += now_ms() - t;
+    st = agree(comm, ctx, st);
+fail:
+    if (ordered != MPI_COMM_NULL)
+        MPI_Comm_free(&ordered);
+    free(order);
+    free(all);
+    free(frame);
+    return st;
+}
+
 umbra_status umbra_mpi_render(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
                               umbra_volume volume, const umbra_camera *camera, uint32_t width,
                               uint32_t height, const float background[4],
                               umbra_mpi_composite_mode mode, int root, float *image,
                               umbra_mpi_stats *stats)
 {
+    if (mode == UMBRA_MPI_COMPOSITE_CHAIN)
+        return render_chain(comm, ctx, r, volume, camera, width, height, background, root, image,
+                            stats);
     umbra_part_rect rect = {0, 0, 0, 0};
     umbra_part_desc part, *all = NULL;
     umbra_volume_info placement;

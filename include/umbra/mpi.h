@@ -143,7 +143,15 @@ typedef enum umbra_mpi_composite_mode {
     /* Every partial image (its rectangle only) gathered at root (MPI_Gatherv) and composited
      * there front to back, one after the other: the order of the floating-point operations does
      * not depend on the number of ranks or the MPI library's reduction tree. */
-    UMBRA_MPI_COMPOSITE_SEQUENTIAL = 1
+    UMBRA_MPI_COMPOSITE_SEQUENTIAL = 1,
+    /* One frame passed down the ranks in view order (MPI_Send, MPI_Recv), each rank adding its
+     * part's samples to the accumulation of the parts in front (umbra_renderer_render_part_into)
+     * and the last handing it to root: one device's image bit for bit, where the two modes above
+     * round the over operator differently (within 1e-6). The renders run one after the other, so
+     * the render stage takes the sum of the ranks' times, not the largest, and each rank sends a
+     * whole frame (docs/distributed.md). umbra_mpi_render only (umbra_mpi_composite refuses it:
+     * it has no renderer). */
+    UMBRA_MPI_COMPOSITE_CHAIN = 2
 } umbra_mpi_composite_mode;
 
 /* Collective: renders r's part (umbra_renderer_render_part of a width x height image; volume and

@@ -24,11 +24,12 @@
  *
  * What a part renders:
  *   - UMBRA_SHADOW_NONE, every option but those listed as refused below;
- *   - UMBRA_SHADOW_THRESHOLD, after the light exchange below: its map equals one device's map of
- *     the whole volume, depth for depth;
- *   - CSSM and the deep map need the same kind of exchange (what crosses parts along the light:
- *     the transmittance reaching a part, the stored depths); they return UMBRA_ERROR_UNSUPPORTED
- *     naming the technique until they implement it (umbra_renderer_part_light_info);
+ *   - UMBRA_SHADOW_THRESHOLD and UMBRA_SHADOW_CSSM, after the light exchange below: their maps
+ *     equal one device's map of the whole volume, depth for depth (CSSM: the same photons, seed
+ *     and ray blocks, grey or coloured);
+ *   - the deep map needs the same kind of exchange (the transmittance reaching a part); it
+ *     returns UMBRA_ERROR_UNSUPPORTED naming the technique until it implements it
+ *     (umbra_renderer_part_light_info);
  *   - refused on a part, each with UMBRA_ERROR_UNSUPPORTED naming the reason: the exact
  *     reference (shadow rays would cross parts) and convolution (slices over the whole view
  *     depth): they do not split; moments; the projection modes (MIP, MinIP, average); volumes
@@ -38,7 +39,8 @@
  *
  * Early ray termination acts within a part's own segment: with termination below 1 a part
  * behind another still adds what one device would have dropped (at most 1 - termination of the
- * pixel); parts equal one device when termination is 1. */
+ * pixel); parts equal one device when termination is 1. Rendered part after part into one frame
+ * (umbra_renderer_render_part_into) a ray ends where one device's ends, at any termination. */
 #ifndef UMBRA_PART_H
 #define UMBRA_PART_H
 
@@ -116,17 +118,33 @@ UMBRA_API umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t wid
                                                   uint32_t height, umbra_part_rect *rect,
                                                   float *rgba);
 
+/* The part's samples added to the accumulation of the parts in front of it, as one device's ray
+ * adds them: frame is the width x height image (premultiplied float RGBA, row 0 at the top, no
+ * background) the parts before this one in view order (umbra_part_view_order) rendered into,
+ * starting from 0; the pixels of the part's rectangle (*rect, as umbra_renderer_part_rect sets
+ * it; NULL: not reported) go on from its colour and opacity, front to back, and are written back;
+ * the others are left as they are. After the last part, umbra_part_background gives one device's
+ * image bit for bit (the same sums in the same order; early ray termination included: a ray
+ * ended in front takes no sample here), where umbra_renderer_render_part's partial images,
+ * composited with the over operator, round differently (docs/distributed.md). The price: each
+ * part waits for the ones in front of it. A pixel of the rectangle with an opacity outside
+ * [0, 1] or a NaN is refused with UMBRA_ERROR_INVALID_ARGUMENT naming it; otherwise as
+ * umbra_renderer_render_part. */
+UMBRA_API umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width,
+                                                       uint32_t height, umbra_part_rect *rect,
+                                                       float *frame);
+
 /* What crosses parts along the light for the renderer's technique, in light order. The threshold
- * map exchanges light (UMBRA_PART_LIGHT_TAU_DEPTH); CSSM and the deep map are refused by name
- * for now, and the kinds say what each will export and import. */
+ * map and CSSM exchange light (UMBRA_PART_LIGHT_TAU_DEPTH); the deep map is refused by name for
+ * now, and its kind says what it will export and import. */
 typedef enum umbra_part_light_kind {
     UMBRA_PART_LIGHT_NOTHING = 0,  /* no light pass (UMBRA_SHADOW_NONE): nothing to exchange */
     UMBRA_PART_LIGHT_TAU = 1,      /* deep map: export tau_exit; import tau_in, the product of
                                       the exit maps of the parts before this one on each ray */
-    UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map and CSSM: export tau_exit, import tau_in
-                                      (the threshold build then uses theta' = 1 - (1 - theta) /
-                                      tau_in per texel), export the depths, import their
-                                      minimum over all parts */
+    UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map and CSSM: export the march state at the
+                                      part's exit, import the state the part before it left
+                                      (light order), export the depths, import their minimum
+                                      over all parts */
     UMBRA_PART_LIGHT_DEPTH = 3     /* a map whose local decisions need nothing from the other
                                       parts (segments indexed along the global light ray): export
                                       the depths, import their minimum. umbra's CSSM is not one:
@@ -143,8 +161,12 @@ typedef struct umbra_part_light_info {
                                       parts: fitted to the global box) */
     uint32_t channels;             /* floats per texel of the transmittance arrays: for the
                                       threshold map 2, its march's state (the product of the
-                                      whole segments' 1 - alpha and an optical depth) */
-    uint32_t depth_channels;       /* floats per texel of the depth arrays */
+                                      whole segments' 1 - alpha and an optical depth); for CSSM
+                                      the optical depth from the light per simulated light
+                                      channel (1 grey, 3 coloured transmission; 0 reaching the
+                                      first part) */
+    uint32_t depth_channels;       /* floats per texel of the depth arrays: 1 for the threshold
+                                      map, CSSM's channels (a photon depth per channel) */
     size_t tau_floats;             /* map_size^2 * channels, or 0 */
     size_t depth_floats;           /* map_size^2 * depth_channels, or 0 */
 } umbra_part_light_info;
@@ -168,9 +190,11 @@ UMBRA_API umbra_status umbra_renderer_part_light_info(umbra_renderer r,
 UMBRA_API umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r, float *tau_exit);
 
 /* Sets the state reaching the part along each light ray (info.tau_floats floats, as the part
- * before it exported them; NULL: the light's, transmittance 1, for the first part on every
- * ray). Copied; the next build marches from it. A transmittance outside [0, 1], a negative
- * optical depth or NaN is refused naming the texel. */
+ * before it exported them; NULL: the light's, transmittance 1 and optical depth 0, for the first
+ * part on every ray). Copied; the next build marches from it. A transmittance outside [0, 1], a
+ * negative optical depth or NaN is refused naming the texel and the value. CSSM's photons of a
+ * ray block share a ray: the block's first texel's state is the one its build goes on from, and
+ * the export writes the end state to every texel of the block. */
 UMBRA_API umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r,
                                                                 const float *tau_in);
 
@@ -181,8 +205,10 @@ UMBRA_API umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float
 
 /* Sets the depths the lookups compare against: the element-wise minimum of all parts' exported
  * depths (umbra_part_minimum). Copied into the built map. NaN is refused naming the texel. A
- * part renders a threshold map only after this import, and only while no light input has
- * changed since (else UMBRA_ERROR_INVALID_ARGUMENT: exchange again). */
+ * part renders a threshold map or CSSM only after this import, and only while no light input
+ * has changed since (else UMBRA_ERROR_INVALID_ARGUMENT: exchange again). A CSSM part stores the
+ * depth of the photons it stopped and the "never" depth for those stopped before it (the imported
+ * optical depth passed their threshold) or after it, so the minimum is one device's map. */
 UMBRA_API umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths);
 
 /* ---- Host helpers: pure functions on the arrays above (no context, no device). ---- */
@@ -216,7 +242,7 @@ UMBRA_API umbra_status umbra_part_composite(float *frame, uint32_t width, uint32
 UMBRA_API void umbra_part_over(const float *front, const float *back, float *out, size_t count);
 
 /* Puts a composited image over the background as one device does: C + (1 - a) background, for
- * count pixels. */
+ * count pixels, one fused multiply-add per channel as the ray caster's (the same rounding). */
 UMBRA_API void umbra_part_background(float *rgba, size_t count, const float background[4]);
 
 /* acc[i] *= t[i] for count floats: one step of the prefix product of exit transmittances in

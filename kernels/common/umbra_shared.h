@@ -35,6 +35,9 @@ typedef int int32_t;
 #define UMBRA_FLAG_ORTHO 16u
 #define UMBRA_FLAG_COLORED 32u
 #define UMBRA_FLAG_POINT_LIGHT 64u
+/* A part's view rays go on from the colour and opacity the parts in front of it accumulated,
+ * read from the output buffer (umbra_renderer_render_part_into, host/part_render.c). */
+#define UMBRA_FLAG_PART_FRONT 128u
 
 /* A volume of several channels, or a label map (kernels/common/channels.cl; host/channels.c
  * fills it). Channel c's voxels follow channel c - 1's in the one volume buffer, each channel

@@ -102,7 +102,11 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
                          __global const UmbraShadow *S, __global const UmbraCssm *P,
-                         __global float *map)
+                         __global float *map
+#if UMBRA_PART
+                         , __global float *part_state
+#endif
+                         )
 {
     const int n = (int)S->map_size, B = clamp((int)P->ray_block, 1, UMBRA_CSSM_MAX_RAY_BLOCK);
     const int x0 = (int)get_global_id(0) * B, y0 = (int)get_global_id(1) * B;
@@ -153,13 +157,46 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             next[c] = 0;
         int going = np * UMBRA_LIGHT_CHANNELS;
         light_t e_next = (light_t)(e[0]); /* per channel, that photon's threshold */
-        for (int k = 0; k <= n_full;) {
+#if UMBRA_PART
+        /* A part goes on with the optical depth per channel the parts before it on this ray left
+         * (host/part_render.c; the block's first texel holds it): the same sum as one device's
+         * march, bit for bit. A photon whose threshold that depth has passed was stopped by an
+         * earlier part, which stored its depth; here it keeps LS_DEPTH_NEVER, and the minimum
+         * over the parts' maps is one device's map. */
+        const int s0 = (y0 * n + x0) * UMBRA_LIGHT_CHANNELS;
+        {
+            float en[UMBRA_LIGHT_CHANNELS];
+            for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
+                const float tc = part_state[s0 + c];
+                int i = 0;
+                while (i < np && tc > e[i])
+                    ++i;
+                next[c] = i;
+                going -= i;
+                en[c] = i < np ? e[i] : UMBRA_INF;
+            }
+            tau = LIGHT_FROM(part_state + s0);
+            e_next = LIGHT_FROM(en);
+        }
+        int owned = 0;
+#endif
+        for (int k = 0; k <= n_full && going > 0;) {
             if (skip && k < n_full && tb.x + ((float)k + 0.5f) * h >= t_cell)
                 k = walk_next_sample(&w, g, light_cells, tb.x, h, 0.5f, k, n_full, tb.y, &t_cell);
             const float seg = k < n_full ? h : last;
             if (!(seg > 0.0f))
                 break;
             const float t_mid = tb.x + (float)k * h + 0.5f * seg;
+#if UMBRA_PART
+            /* Only the segments whose midpoint the part owns; the first after them ends it. */
+            if (!part_owns(F, world_to_voxel(g, o + t_mid * d))) {
+                if (owned)
+                    break;
+                ++k;
+                continue;
+            }
+            owned = 1;
+#endif
             const float4 col = light_sample(F, vol, g, light_tf, n_tf, o + t_mid * d);
             if (col.w > 0.0f) {
                 tau += cssm_depth(col, h_vox * (seg / h), flags);
@@ -182,6 +219,14 @@ __kernel void cssm_build(__global const UmbraFrame *F, VOLUME_PARAM,
             }
             ++k;
         }
+#if UMBRA_PART
+        /* The state at the part's exit, for the part after it: every texel of the block. */
+        for (int j = 0; j < bw * bh; ++j) {
+            const int si = ((y0 + j / bw) * n + x0 + j % bw) * UMBRA_LIGHT_CHANNELS;
+            for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c)
+                part_state[si + c] = LIGHT_CH(tau, c);
+        }
+#endif
     }
     for (int i = 0; i < np; ++i)
         CSSM_STORE(LIGHT_FROM(z + i * UMBRA_LIGHT_CHANNELS), (y0 + id[i] / B) * n + x0 + id[i] % B,
