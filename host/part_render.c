@@ -13,6 +13,7 @@
 
 #include "lightspace.h"
 #include "renderer_internal.h"
+#include "techniques/deep.h"
 #include "techniques/maps.h"
 
 static const char *const AXIS = "xyz";
@@ -112,6 +113,32 @@ static void part_rect(umbra_renderer r, uint32_t width, uint32_t height, umbra_p
     out->height = (uint32_t)(y1 - y0) + 1;
 }
 
+/* The deep map on a part: one light ray per texel (the pre-filter's sub-rays would cross a
+ * face at different depths, and a segment's nodes combine all of them), the unbounded map (a
+ * budget chooses its nodes once the whole ray is known) and a light step of at most a voxel (a
+ * segment's two ends then lie within the one ghost layer of the owned midpoint). */
+static umbra_status check_part_deep(umbra_renderer r, const char *fn)
+{
+    const umbra_deep_desc *d = &r->shadow_set.deep;
+    if (d->prefilter != 1)
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with prefilter %u is refused on a part: the "
+                           "sub-texel rays cross the parts' faces at different depths "
+                           "(prefilter 1 splits)", fn, d->prefilter);
+    if (d->max_nodes != 0)
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with max_nodes %u is refused on a part: the "
+                           "budget chooses a texel's nodes once its whole ray is known (the "
+                           "unbounded map, max_nodes 0, splits)", fn, d->max_nodes);
+    const float step = umbra__map_light_step(&r->shadow_set);
+    if (!(step <= 1.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with a light step of %g voxels is refused on a "
+                           "part: a segment's ends must lie within the ghost layer of its "
+                           "midpoint (map_step <= 1)", fn, (double)step);
+    return UMBRA_SUCCESS;
+}
+
 /* What a part cannot render, each refused naming the reason; then the ghost layers. */
 static umbra_status check_part_render(umbra_renderer r, const char *fn)
 {
@@ -139,8 +166,13 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
                            "over the whole view depth", fn, tech);
     case UMBRA_SHADOW_THRESHOLD: /* after its exchange: render_part checks */
         break;
+    case UMBRA_SHADOW_DEEP: {
+        const umbra_status st = check_part_deep(r, fn);
+        if (st != UMBRA_SUCCESS)
+            return st;
+        break;
+    }
     case UMBRA_SHADOW_CSSM:
-    case UMBRA_SHADOW_DEEP:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is not part-aware yet: its light exchange is not "
                            "implemented (none and threshold render on a part)", fn, tech);
@@ -226,7 +258,8 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: rgba is NULL", fn);
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
-    /* A light build now (if its inputs changed) would overwrite the imported depths. */
+    /* A light build now (if its inputs changed) would overwrite the imported depths (or the
+     * deep map's merged pieces). */
     if (r->shadow_set.technique == UMBRA_SHADOW_THRESHOLD) {
         if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
             return st;
@@ -234,6 +267,15 @@ static umbra_status render_part(umbra_renderer r, uint32_t width, uint32_t heigh
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                                "%s: technique threshold: import the depths of all parts "
                                "(umbra_renderer_part_import_depths) after the last light build",
+                               fn);
+    }
+    if (r->shadow_set.technique == UMBRA_SHADOW_DEEP) {
+        if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
+            return st;
+        if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
+            return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: technique deep: import the pieces of all parts "
+                               "(umbra_renderer_part_import_deep) after the last light build",
                                fn);
     }
     umbra__frame_update_light(r);
@@ -286,12 +328,24 @@ umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t width, uint32
  * and the optical depth tau (kernels/techniques/threshold.cl). */
 #define STATE_FLOATS 2u
 
+static int is_deep(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_DEEP;
+}
+
+/* Floats per texel of the state the light march passes on: the threshold map's (P, tau); the
+ * deep map's visibility per light channel (kernels/techniques/deep.cl, part_state). */
+static uint32_t state_floats(umbra_renderer r)
+{
+    return is_deep(r) ? r->channels : STATE_FLOATS;
+}
+
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
     const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
     return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
-                       "%s: technique %s has no light exchange between parts (none and threshold "
-                       "have)", fn, tech ? tech : "?");
+                       "%s: technique %s has no light exchange between parts (none, threshold "
+                       "and deep have)", fn, tech ? tech : "?");
 }
 
 /* The light inputs brought up to date and the map size chosen, for a part whose technique
@@ -302,9 +356,11 @@ static umbra_status light_ready(umbra_renderer r, const char *fn, uint32_t *map_
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: set a part volume (umbra_volume_create_part) and a transfer "
                            "function first", fn);
-    if (r->shadow_set.technique != UMBRA_SHADOW_THRESHOLD)
+    if (r->shadow_set.technique != UMBRA_SHADOW_THRESHOLD && !is_deep(r))
         return light_unsupported(r, fn);
-    umbra_status st = umbra__effective_tfs(r);
+    umbra_status st = is_deep(r) ? check_part_deep(r, fn) : UMBRA_SUCCESS;
+    if (st == UMBRA_SUCCESS)
+        st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__frame_update_light(r);
@@ -318,7 +374,8 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const size_t floats = (size_t)n * n * STATE_FLOATS, bytes = floats * sizeof(float);
+    const uint32_t per = state_floats(r);
+    const size_t floats = (size_t)n * n * per, bytes = floats * sizeof(float);
     if (r->part_state_in && r->part_state_floats != floats)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_render_part: the imported transmittance holds %zu "
@@ -330,10 +387,9 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
         if (!(init = malloc(bytes)))
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
                                "umbra_renderer_render_part");
-        for (size_t i = 0; i < floats; i += STATE_FLOATS) {
-            init[i] = 1.0f;
-            init[i + 1] = 0.0f;
-        }
+        for (size_t i = 0; i < floats; i += per)
+            for (uint32_t c = 0; c < per; ++c) /* threshold: (1, 0); deep: visibility 1 */
+                init[i + c] = c == 0 || is_deep(r) ? 1.0f : 0.0f;
         src = init;
     }
     size_t have = 0;
@@ -369,6 +425,13 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
     umbra_status st = light_ready(r, __func__, &n);
     if (st != UMBRA_SUCCESS)
         return st;
+    if (is_deep(r)) {
+        out->kind = UMBRA_PART_LIGHT_TAU;
+        out->map_size = n;
+        out->channels = r->channels;
+        out->tau_floats = (size_t)n * n * r->channels;
+        return UMBRA_SUCCESS;
+    }
     out->kind = UMBRA_PART_LIGHT_TAU_DEPTH;
     out->map_size = n;
     out->channels = STATE_FLOATS;
@@ -403,14 +466,18 @@ static umbra_status export_light(umbra_renderer r, const char *fn, float *out, i
     umbra_context ctx = r->ctx;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto fail;
-    if (depths) {
+    if (depths && is_deep(r)) {
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: technique deep exchanges pieces of its map, not depths "
+                         "(umbra_renderer_part_export_deep)", fn);
+    } else if (depths) {
         st = umbra__map_read(r, out, (size_t)n * n * sizeof(float));
     } else if (!r->part_state_buf) {
         st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: no march state was built", fn);
     } else {
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
-                                     (size_t)n * n * STATE_FLOATS * sizeof(float), out, 0, NULL,
-                                     NULL));
+                                     (size_t)n * n * state_floats(r) * sizeof(float), out, 0,
+                                     NULL, NULL));
     }
 fail:
     umbra__call_end(r);
@@ -431,9 +498,16 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
     umbra_status st = light_ready(r, fn, &n);
     if (st != UMBRA_SUCCESS)
         return st;
-    const size_t floats = (size_t)n * n * STATE_FLOATS;
+    const uint32_t per = state_floats(r);
+    const size_t floats = (size_t)n * n * per;
     float *copy = NULL;
-    if (tau_in) {
+    if (tau_in && is_deep(r)) {
+        for (size_t i = 0; i < floats; ++i)
+            if (!(tau_in[i] >= 0.0f && tau_in[i] <= 1.0f))
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: texel %zu (%zu, %zu): visibility %g must lie in [0, 1]",
+                                   fn, i / per, i / per % n, i / per / n, tau_in[i]);
+    } else if (tau_in) {
         for (size_t i = 0; i < floats; i += STATE_FLOATS)
             if (!(tau_in[i] >= 0.0f && tau_in[i] <= 1.0f) || !(tau_in[i + 1] >= 0.0f))
                 return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -441,6 +515,8 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
                                    "transmittance product in [0, 1] and an optical depth >= 0",
                                    fn, i / STATE_FLOATS, i / STATE_FLOATS % n,
                                    i / STATE_FLOATS / n, tau_in[i], tau_in[i + 1]);
+    }
+    if (tau_in) {
         if (!(copy = malloc(floats * sizeof *copy)))
             return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
         memcpy(copy, tau_in, floats * sizeof *copy);
@@ -471,6 +547,12 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         return st;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto done;
+    if (is_deep(r)) {
+        st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: technique deep imports pieces of its map, not depths "
+                         "(umbra_renderer_part_import_deep)", fn);
+        goto done;
+    }
     for (size_t i = 0; i < (size_t)n * n; ++i)
         if (isnan(depths[i])) {
             st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -482,6 +564,60 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         r->part_depths_valid = 1;
     }
 done:
+    umbra__call_end(r);
+    return st;
+}
+
+/* ---- the deep map's pieces ----------------------------------------------------------------- */
+
+static umbra_status deep_ready(umbra_renderer r, const char *fn, uint32_t *n)
+{
+    if (!is_deep(r))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: the technique is %s, not deep", fn,
+                           umbra_shadow_technique_name(r->shadow_set.technique));
+    return build(r, fn, n);
+}
+
+umbra_status umbra_renderer_part_export_deep(umbra_renderer r, uint32_t *counts, float *nodes,
+                                             size_t *node_count)
+{
+    CHECK_R();
+    const char *fn = __func__;
+    if (!counts || !node_count)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: counts (%p) and node_count (%p) must not be NULL", fn,
+                           (void *)counts, (void *)node_count);
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    uint32_t n = 0;
+    if ((st = deep_ready(r, fn, &n)) == UMBRA_SUCCESS)
+        st = umbra__deep_part_export(r, counts, nodes, node_count);
+    umbra__call_end(r);
+    return st;
+}
+
+umbra_status umbra_renderer_part_import_deep(umbra_renderer r, uint32_t parts,
+                                             const uint32_t *counts, const float *nodes,
+                                             size_t node_count)
+{
+    CHECK_R();
+    const char *fn = __func__;
+    if (parts == 0 || !counts || (node_count && !nodes))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: parts %u must be > 0, counts (%p) non-NULL and nodes (%p) "
+                           "non-NULL for %zu nodes", fn, parts, (void *)counts, (void *)nodes,
+                           node_count);
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    uint32_t n = 0;
+    if ((st = deep_ready(r, fn, &n)) == UMBRA_SUCCESS &&
+        (st = umbra__deep_part_import(r, parts, counts, nodes, node_count)) == UMBRA_SUCCESS) {
+        r->part_depths_at = r->rebuilds.shadow;
+        r->part_depths_valid = 1;
+    }
     umbra__call_end(r);
     return st;
 }
