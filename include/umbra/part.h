@@ -26,9 +26,16 @@
  *   - UMBRA_SHADOW_NONE, every option but those listed as refused below;
  *   - UMBRA_SHADOW_THRESHOLD, after the light exchange below: its map equals one device's map of
  *     the whole volume, depth for depth;
- *   - CSSM and the deep map need the same kind of exchange (what crosses parts along the light:
- *     the transmittance reaching a part, the stored depths); they return UMBRA_ERROR_UNSUPPORTED
- *     naming the technique until they implement it (umbra_renderer_part_light_info);
+ *   - UMBRA_SHADOW_DEEP (the unbounded map, prefilter 1, a light step of at most a voxel; the
+ *     rest refused by name), after the light exchange below and the exchange of the map's
+ *     pieces (umbra_renderer_part_export_deep): at epsilon 0 its lookups equal one device's to
+ *     float rounding; at epsilon > 0 each part compresses its own piece of a texel's visibility
+ *     function, so the merged function has a node where the ray enters each part and differs
+ *     from one device's by at most 2 epsilon (both lie within epsilon of the same march;
+ *     docs/distributed.md gives the measured image differences);
+ *   - CSSM needs the same kind of exchange (the transmittance reaching a part, the stored
+ *     depths); it returns UMBRA_ERROR_UNSUPPORTED naming the technique until it implements it
+ *     (umbra_renderer_part_light_info);
  *   - refused on a part, each with UMBRA_ERROR_UNSUPPORTED naming the reason: the exact
  *     reference (shadow rays would cross parts) and convolution (slices over the whole view
  *     depth): they do not split; moments; the projection modes (MIP, MinIP, average); volumes
@@ -117,12 +124,14 @@ UMBRA_API umbra_status umbra_renderer_render_part(umbra_renderer r, uint32_t wid
                                                   float *rgba);
 
 /* What crosses parts along the light for the renderer's technique, in light order. The threshold
- * map exchanges light (UMBRA_PART_LIGHT_TAU_DEPTH); CSSM and the deep map are refused by name
- * for now, and the kinds say what each will export and import. */
+ * map exchanges UMBRA_PART_LIGHT_TAU_DEPTH, the deep map UMBRA_PART_LIGHT_TAU; CSSM is refused by
+ * name for now, and the kinds say what it will export and import. */
 typedef enum umbra_part_light_kind {
     UMBRA_PART_LIGHT_NOTHING = 0,  /* no light pass (UMBRA_SHADOW_NONE): nothing to exchange */
-    UMBRA_PART_LIGHT_TAU = 1,      /* deep map: export tau_exit; import tau_in, the product of
-                                      the exit maps of the parts before this one on each ray */
+    UMBRA_PART_LIGHT_TAU = 1,      /* deep map: the visibility per texel passed on in light
+                                      order (export after import, as the threshold map's
+                                      state), then every part's pieces of the map to every part
+                                      (umbra_renderer_part_export_deep, _import_deep) */
     UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map and CSSM: export tau_exit, import tau_in
                                       (the threshold build then uses theta' = 1 - (1 - theta) /
                                       tau_in per texel), export the depths, import their
@@ -143,7 +152,9 @@ typedef struct umbra_part_light_info {
                                       parts: fitted to the global box) */
     uint32_t channels;             /* floats per texel of the transmittance arrays: for the
                                       threshold map 2, its march's state (the product of the
-                                      whole segments' 1 - alpha and an optical depth) */
+                                      whole segments' 1 - alpha and an optical depth); for the
+                                      deep map the light channels (1 grey, 3 coloured), its
+                                      visibility; a deep node is 1 + channels floats */
     uint32_t depth_channels;       /* floats per texel of the depth arrays */
     size_t tau_floats;             /* map_size^2 * channels, or 0 */
     size_t depth_floats;           /* map_size^2 * depth_channels, or 0 */
@@ -156,7 +167,8 @@ UMBRA_API umbra_status umbra_renderer_part_light_info(umbra_renderer r,
                                                       umbra_part_light_info *out);
 
 /* Light pass 1: marches the part's own segments of every light ray (those whose midpoint its
- * core owns, at the global ray's t0 + (k + 1/2) step), going on from the imported state, and
+ * core owns, at the global ray's t0 + (k + 1/2) step; for the deep map the segments of its
+ * global depth grid), going on from the imported state, and
  * writes the state at their end per texel (info.tau_floats floats, texel (u, v) at
  * (v * map_size + u) * channels; the imported state where the ray misses the part). The state
  * is the light's from the light to the part's exit, not the part's own, so parts pass it on in
