@@ -211,6 +211,33 @@ UMBRA_API umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float
  * optical depth passed their threshold) or after it, so the minimum is one device's map. */
 UMBRA_API umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths);
 
+/* The deep map's pieces (UMBRA_PART_LIGHT_TAU). After the import of the visibility reaching
+ * it (umbra_renderer_part_import_transmittance, in light order as for the threshold map; for
+ * the deep map info.channels floats per texel, the visibility per light channel), a part's map
+ * holds per texel the nodes of the light-ray segments whose midpoint its core owns: its piece
+ * of the texel's visibility function, depths in the global light frame. Every part's lookups
+ * need the whole function of the texels its samples fall in (a texel's ray can run through a
+ * neighbour's core at the sample's depth), so the pieces of all parts are gathered and each
+ * part merges them into its map.
+ *
+ * Export: builds if needed, writes the node count of each texel (info.map_size^2 counts) and,
+ * unless nodes is NULL, the nodes in texel order (1 + info.channels floats each: depth, then
+ * visibility per channel); *node_count is the capacity of nodes in nodes (ignored for NULL)
+ * and is set to the number of nodes. A capacity below it is refused naming both. */
+UMBRA_API umbra_status umbra_renderer_part_export_deep(umbra_renderer r, uint32_t *counts,
+                                                       float *nodes, size_t *node_count);
+
+/* Import: the pieces of `parts` parts (every part's, this one's included, in any order): counts
+ * holds parts x info.map_size^2 counts (part-major, as each export wrote them), nodes their node
+ * arrays one after another (node_count nodes in all). Merged per texel in depth order (the
+ * pieces of a texel lie in disjoint depth ranges) into this part's map, laid out in blocks as a
+ * build lays them out, so the lookup is one device's. Counts that do not add up to node_count,
+ * a NaN depth or a visibility outside [0, 1] are refused naming the value. A part renders the
+ * deep map only after this import, and only while no light input has changed since. */
+UMBRA_API umbra_status umbra_renderer_part_import_deep(umbra_renderer r, uint32_t parts,
+                                                       const uint32_t *counts,
+                                                       const float *nodes, size_t node_count);
+
 /* ---- Host helpers: pure functions on the arrays above (no context, no device). ---- */
 
 /* The visibility order of count parts (descs[i], all of one global grid) seen from a point
