@@ -1056,6 +1056,45 @@ static void test_bad_input_refused(void **state)
                            UMBRA_ERROR_INVALID_ARGUMENT, "frame is NULL", NULL);
         free(frame);
     }
+    /* The deep map renders on a part only after its pieces are imported; pieces that do not
+     * add up, or hold a NaN depth, are refused. */
+    {
+        umbra_shadow_desc sd;
+        umbra_shadow_desc_init(&sd);
+        sd.technique = UMBRA_SHADOW_DEEP;
+        sd.map.size = 32;
+        assert_int_equal(umbra_renderer_set_shadow(r, &sd), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_render_part(r, W, H, &rect, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "import the pieces", NULL);
+        umbra_part_light_info li = {.struct_size = sizeof li};
+        assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
+        assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU);
+        const size_t texels = (size_t)li.map_size * li.map_size, nf = 1 + li.channels;
+        uint32_t *counts = malloc(texels * sizeof *counts);
+        size_t k = 0;
+        assert_non_null(counts);
+        assert_int_equal(umbra_renderer_part_export_deep(r, counts, NULL, &k), UMBRA_SUCCESS);
+        assert_true(k > 0);
+        float *nodes = malloc(k * nf * sizeof *nodes);
+        assert_non_null(nodes);
+        size_t small = k - 1;
+        test_assert_failed(ctx, umbra_renderer_part_export_deep(r, counts, nodes, &small),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "nodes holds", NULL);
+        assert_int_equal(umbra_renderer_part_export_deep(r, counts, nodes, &k), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_part_import_deep(r, 1, counts, nodes, k + 1),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "add up to", NULL);
+        const float depth = nodes[0];
+        nodes[0] = NAN;
+        test_assert_failed(ctx, umbra_renderer_part_import_deep(r, 1, counts, nodes, k),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "node 0: depth", NULL);
+        nodes[0] = depth;
+        assert_int_equal(umbra_renderer_part_import_deep(r, 1, counts, nodes, k), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_render_part(r, W, H, &rect, img), UMBRA_SUCCESS);
+        test_assert_failed(ctx, umbra_renderer_part_import_depths(r, img),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "not depths", NULL);
+        free(counts);
+        free(nodes);
+    }
     /* A whole volume is not a part. */
     umbra_renderer_release(r);
     umbra_volume w = test_volume(ctx, NX, NY, NZ, voxels);
