@@ -167,6 +167,27 @@ uint32_t make_parts(const uint32_t *const cuts[3], const uint32_t ncuts[3], int 
     return n;
 }
 
+/* The part volume of part p of the scene's voxels: its core and ghost layers (one voxel for an
+ * empty part), with the scene's volume description. */
+umbra_volume part_volume(umbra_context ctx, const float *voxels, const umbra_part_desc *p)
+{
+    const int empty = p->size[0] == 0;
+    uint32_t lo[3], dims[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = p->offset[a] - p->ghost_lo[a];
+        dims[a] = empty ? 1 : p->ghost_lo[a] + p->size[a] + p->ghost_hi[a];
+    }
+    float *box = sub_box(voxels, lo, dims);
+    umbra_volume_desc d;
+    volume_desc(&d, box, dims[0], dims[1], dims[2]);
+    umbra_volume v = NULL;
+    if (umbra_volume_create_part(ctx, &d, p, &v) != UMBRA_SUCCESS)
+        fail_msg("part at (%u, %u, %u): %s", p->offset[0], p->offset[1], p->offset[2],
+                 take_message(ctx));
+    free(box);
+    return v;
+}
+
 /* Counts the floats of a and b whose bits differ. */
 size_t bits_differing(const float *a, const float *b, size_t count)
 {
@@ -212,22 +233,10 @@ float *render_parts(umbra_context ctx, const float *voxels, umbra_transfer_funct
     for (uint32_t i = 0; i < n; ++i) {
         const umbra_part_desc *p = &parts[i];
         const int empty = p->size[0] == 0;
-        uint32_t lo[3], dims[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = p->offset[a] - p->ghost_lo[a];
-            dims[a] = empty ? 1 : p->ghost_lo[a] + p->size[a] + p->ghost_hi[a];
-        }
-        float *box = sub_box(voxels, lo, dims);
-        umbra_volume_desc d;
-        volume_desc(&d, box, dims[0], dims[1], dims[2]);
-        umbra_volume v = NULL;
-        umbra_status st = umbra_volume_create_part(ctx, &d, p, &v);
-        if (st != UMBRA_SUCCESS)
-            fail_msg("part %u: %s", i, take_message(ctx));
-        free(box);
+        umbra_volume v = part_volume(ctx, voxels, p);
         assert_int_equal(umbra_volume_get_info(v, &info), UMBRA_SUCCESS);
         umbra_renderer r = scene_renderer(ctx, v, tf, s);
-        st = umbra_renderer_render_part(r, W, H, &rects[i], part_img);
+        const umbra_status st = umbra_renderer_render_part(r, W, H, &rects[i], part_img);
         if (st != UMBRA_SUCCESS)
             fail_msg("part %u: %s", i, take_message(ctx));
         umbra_part_rect again;

@@ -50,6 +50,10 @@ float *sub_box(const float *voxels, const uint32_t lo[3], const uint32_t n[3]);
 uint32_t make_parts(const uint32_t *const cuts[3], const uint32_t ncuts[3], int extra_empty,
                     uint32_t ghost, umbra_part_desc *parts);
 
+/* The part volume of part p of the scene's voxels: its core and ghost layers (one voxel for an
+ * empty part), with the scene's volume description. */
+umbra_volume part_volume(umbra_context ctx, const float *voxels, const umbra_part_desc *p);
+
 /* Counts the floats of a and b whose bits differ. */
 size_t bits_differing(const float *a, const float *b, size_t count);
 

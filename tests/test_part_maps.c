@@ -62,17 +62,7 @@ static float compare_map(umbra_context ctx, const float *voxels, umbra_transfer_
     umbra_renderer rs[16];
     umbra_volume_info info;
     for (uint32_t i = 0; i < n; ++i) {
-        const umbra_part_desc *p = &parts[i];
-        const int empty = p->size[0] == 0;
-        uint32_t lo[3], dims[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = p->offset[a] - p->ghost_lo[a];
-            dims[a] = empty ? 1 : p->ghost_lo[a] + p->size[a] + p->ghost_hi[a];
-        }
-        float *box = sub_box(voxels, lo, dims);
-        volume_desc(&d, box, dims[0], dims[1], dims[2]);
-        assert_int_equal(umbra_volume_create_part(ctx, &d, p, &vols[i]), UMBRA_SUCCESS);
-        free(box);
+        vols[i] = part_volume(ctx, voxels, &parts[i]);
         assert_int_equal(umbra_volume_get_info(vols[i], &info), UMBRA_SUCCESS);
         rs[i] = scene_renderer(ctx, vols[i], tf, s);
         assert_int_equal(umbra_renderer_set_shadow(rs[i], &sd), UMBRA_SUCCESS);
@@ -227,17 +217,7 @@ static deep_result compare_deep(umbra_context ctx, const float *voxels, umbra_tr
     umbra_renderer rs[16];
     umbra_volume_info info;
     for (uint32_t i = 0; i < n; ++i) {
-        const umbra_part_desc *p = &parts[i];
-        const int empty = p->size[0] == 0;
-        uint32_t lo[3], dims[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = p->offset[a] - p->ghost_lo[a];
-            dims[a] = empty ? 1 : p->ghost_lo[a] + p->size[a] + p->ghost_hi[a];
-        }
-        float *box = sub_box(voxels, lo, dims);
-        volume_desc(&d, box, dims[0], dims[1], dims[2]);
-        assert_int_equal(umbra_volume_create_part(ctx, &d, p, &vols[i]), UMBRA_SUCCESS);
-        free(box);
+        vols[i] = part_volume(ctx, voxels, &parts[i]);
         assert_int_equal(umbra_volume_get_info(vols[i], &info), UMBRA_SUCCESS);
         rs[i] = scene_renderer(ctx, vols[i], tf, s);
         assert_int_equal(umbra_renderer_set_shadow(rs[i], &sd), UMBRA_SUCCESS);
