@@ -61,24 +61,6 @@ enum { BASELINE = 0, MATCHED = 1, MAX_VARIANTS = 32 };
 static variant variants[MAX_VARIANTS];
 static int variant_count;
 
-/* Whether name is one of the comma-separated list (NULL: every name is). */
-static int listed(const char *list, const char *name)
-{
-    if (!list)
-        return 1;
-    const size_t n = strlen(name);
-    for (const char *p = list; *p;) {
-        const char *e = strchr(p, ',');
-        const size_t len = e ? (size_t)(e - p) : strlen(p);
-        if (len == n && strncmp(p, name, n) == 0)
-            return 1;
-        if (!e)
-            break;
-        p = e + 1;
-    }
-    return 0;
-}
-
 /* The variants from the registry, in its order: each build setting of each light-space map,
  * grey, and coloured too for a technique that carries colour; of them only those named in only
  * (NULL: all) beside the first two, the ratios' bases. */
@@ -101,7 +83,7 @@ static void make_variants(const char *only)
                 v->technique = tech->info.id;
                 v->params = tech->sweep[i].params;
                 v->transmission = colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
-                if (variant_count > MATCHED + 1 && !listed(only, v->name))
+                if (variant_count > MATCHED + 1 && only && !bench_in_list(only, v->name))
                     --variant_count;
             }
         }
