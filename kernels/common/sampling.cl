@@ -431,7 +431,7 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * loaded as stored (uchar, ushort or short without UMBRA_VOXEL_CLAMPS) spanning at most 32767
  * (the host builds the volume only there), so gradient_volume_sample blends the same floats in
  * the same order: the same gradient bit for bit. 8 bytes a voxel, built only for shaded frames
- * and again when the volume changes (host/renderer.c, gradient_volume). Whole volumes in one
+ * and again when the volume changes (host/gradient_volume.c). Whole volumes in one
  * buffer only (UMBRA_GRADIENT_VOLUME). */
 #if !UMBRA_PART && !UMBRA_VOXEL_CLAMPS
 #define UMBRA_GRADIENT_VOLUME 1
