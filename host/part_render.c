@@ -13,6 +13,7 @@
 
 #include "lightspace.h"
 #include "renderer_internal.h"
+#include "techniques/deep.h"
 #include "techniques/maps.h"
 
 static const char *const AXIS = "xyz";
@@ -114,6 +115,32 @@ static void part_rect(umbra_renderer r, uint32_t width, uint32_t height, umbra_p
     out->height = (uint32_t)(y1 - y0) + 1;
 }
 
+/* The deep map on a part: one light ray per texel (the pre-filter's sub-rays would cross a
+ * face at different depths, and a segment's nodes combine all of them), the unbounded map (a
+ * budget chooses its nodes once the whole ray is known) and a light step of at most a voxel (a
+ * segment's two ends then lie within the one ghost layer of the owned midpoint). */
+static umbra_status check_part_deep(umbra_renderer r, const char *fn)
+{
+    const umbra_deep_desc *d = &r->shadow_set.deep;
+    if (d->prefilter != 1)
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with prefilter %u is refused on a part: the "
+                           "sub-texel rays cross the parts' faces at different depths "
+                           "(prefilter 1 splits)", fn, d->prefilter);
+    if (d->max_nodes != 0)
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with max_nodes %u is refused on a part: the "
+                           "budget chooses a texel's nodes once its whole ray is known (the "
+                           "unbounded map, max_nodes 0, splits)", fn, d->max_nodes);
+    const float step = umbra__map_light_step(&r->shadow_set);
+    if (!(step <= 1.0f))
+        return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
+                           "%s: technique deep with a light step of %g voxels is refused on a "
+                           "part: a segment's ends must lie within the ghost layer of its "
+                           "midpoint (map_step <= 1)", fn, (double)step);
+    return UMBRA_SUCCESS;
+}
+
 /* What a part cannot render, each refused naming the reason; then the ghost layers. */
 static umbra_status check_part_render(umbra_renderer r, const char *fn)
 {
@@ -142,10 +169,12 @@ static umbra_status check_part_render(umbra_renderer r, const char *fn)
     case UMBRA_SHADOW_THRESHOLD: /* after its exchange: render_part checks */
     case UMBRA_SHADOW_CSSM:
         break;
-    case UMBRA_SHADOW_DEEP:
-        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                           "%s: technique %s is not part-aware yet: its light exchange is not "
-                           "implemented (none, threshold and cssm render on a part)", fn, tech);
+    case UMBRA_SHADOW_DEEP: {
+        const umbra_status st = check_part_deep(r, fn);
+        if (st != UMBRA_SUCCESS)
+            return st;
+        break;
+    }
     default:
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
                            "%s: technique %s is refused on a part: its light structure has no "
@@ -214,10 +243,41 @@ umbra_status umbra_renderer_part_rect(umbra_renderer r, uint32_t width, uint32_t
     return UMBRA_SUCCESS;
 }
 
-/* The techniques whose part marches the light and exchanges depths: threshold and CSSM. */
-static int exchanges_depths(umbra_shadow_technique t)
+/* A technique whose parts march the light (threshold, CSSM, deep): the state one part hands the
+ * next on a texel's light ray, and what the parts share once all have marched.
+ *  - state: floats per texel, or 0 for one per light channel (r->channels, set by
+ *    umbra__frame_update_light); per float (one slot for every channel when per channel) its
+ *    value for a part first on the ray, the range an import must lie in and its name;
+ *  - shares: a depth per texel or per channel, which the parts reduce with umbra_part_minimum,
+ *    or the pieces of the deep map, merged per texel (umbra_renderer_part_export_deep). */
+typedef enum { SHARES_DEPTH, SHARES_DEPTH_PER_CHANNEL, SHARES_PIECES } PartShares;
+
+typedef struct PartLight {
+    umbra_shadow_technique technique;
+    uint32_t state;
+    float start[2], lo[2], hi[2];
+    const char *name[2];
+    PartShares shares;
+} PartLight;
+
+static const PartLight PART_LIGHTS[] = {
+    /* kernels/techniques/threshold.cl: the product P of whole segments' 1 - alpha and the
+     * optical depth tau. */
+    {UMBRA_SHADOW_THRESHOLD, 2, {1.0f, 0.0f}, {0.0f, 0.0f}, {1.0f, INFINITY},
+     {"transmittance product", "optical depth"}, SHARES_DEPTH},
+    /* kernels/techniques/cssm.cl: the optical depth of each channel's photon. */
+    {UMBRA_SHADOW_CSSM, 0, {0.0f}, {0.0f}, {INFINITY}, {"optical depth"},
+     SHARES_DEPTH_PER_CHANNEL},
+    /* kernels/techniques/deep.cl (part_state): the visibility per channel. */
+    {UMBRA_SHADOW_DEEP, 0, {1.0f}, {0.0f}, {1.0f}, {"visibility"}, SHARES_PIECES},
+};
+
+static const PartLight *part_light(umbra_shadow_technique t)
 {
-    return t == UMBRA_SHADOW_THRESHOLD || t == UMBRA_SHADOW_CSSM;
+    for (size_t i = 0; i < sizeof PART_LIGHTS / sizeof PART_LIGHTS[0]; ++i)
+        if (PART_LIGHTS[i].technique == t)
+            return &PART_LIGHTS[i];
+    return NULL;
 }
 
 /* The front state of the frame's rectangle refused naming the first bad pixel: an opacity
@@ -254,15 +314,20 @@ static umbra_status render_part(umbra_renderer r, const char *fn, uint32_t width
                            into ? "frame" : "rgba");
     if ((st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
         return st;
-    /* A light build now (if its inputs changed) would overwrite the imported depths. */
-    if (exchanges_depths(r->shadow_set.technique)) {
+    /* A light build now (if its inputs changed) would overwrite the imported depths (or the
+     * deep map's merged pieces). */
+    const PartLight *light = part_light(r->shadow_set.technique);
+    if (light) {
         if ((st = umbra__prepare_shadow(r, 0.5, 1)) != UMBRA_SUCCESS)
             return st;
+        const int pieces = light->shares == SHARES_PIECES;
         if (!r->part_depths_valid || r->part_depths_at != r->rebuilds.shadow)
             return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: technique %s: import the depths of all parts "
-                               "(umbra_renderer_part_import_depths) after the last light build",
-                               fn, umbra_shadow_technique_name(r->shadow_set.technique));
+                               "%s: technique %s: import the %s of all parts (%s) after the last "
+                               "light build", fn, umbra_shadow_technique_name(light->technique),
+                               pieces ? "pieces" : "depths",
+                               pieces ? "umbra_renderer_part_import_deep"
+                                      : "umbra_renderer_part_import_depths");
     }
     umbra__frame_update_light(r);
     umbra__frame_update_view(r, width, height);
@@ -336,74 +401,69 @@ umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width, u
 
 /* ---- the light exchange -------------------------------------------------------------------- */
 
-/* Floats per texel of the threshold march's state: the product P of whole segments' 1 - alpha
- * and the optical depth tau (kernels/techniques/threshold.cl). */
-#define STATE_FLOATS 2u
-
-/* The march state per technique: floats per texel, the light's (a part first on its ray), and
- * the depths' floats per texel. Threshold: (P, tau), (1, 0), one depth. CSSM: the optical depth
- * per simulated light channel (kernels/techniques/cssm.cl), 0, a depth per channel (r->channels,
- * set by umbra__frame_update_light). */
-static uint32_t state_floats(umbra_renderer r)
+static uint32_t state_floats(umbra_renderer r, const PartLight *light)
 {
-    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : STATE_FLOATS;
+    return light->state ? light->state : r->channels;
 }
 
-static uint32_t depth_floats(umbra_renderer r)
+static uint32_t depth_floats(umbra_renderer r, const PartLight *light)
 {
-    return r->shadow_set.technique == UMBRA_SHADOW_CSSM ? r->channels : 1u;
+    return light->shares == SHARES_DEPTH ? 1u
+           : light->shares == SHARES_DEPTH_PER_CHANNEL ? r->channels
+                                                       : 0u;
 }
 
-static void state_start(umbra_renderer r, float *state, size_t floats)
+/* The index into a PartLight's start/lo/hi/name of state float i. */
+static uint32_t state_slot(const PartLight *light, size_t i)
 {
-    const int cssm = r->shadow_set.technique == UMBRA_SHADOW_CSSM;
-    for (size_t i = 0; i < floats; ++i)
-        state[i] = cssm || i % STATE_FLOATS ? 0.0f : 1.0f;
+    return light->state ? (uint32_t)(i % light->state) : 0u;
 }
 
-/* An imported state's first bad texel, refused naming it and its value. */
-static umbra_status state_check(umbra_renderer r, const char *fn, const float *s, uint32_t n)
+/* An imported state's first bad value, refused naming its texel, channel and value. */
+static umbra_status state_check(umbra_renderer r, const PartLight *light, const char *fn,
+                                const float *s, uint32_t n)
 {
-    const size_t floats = (size_t)n * n * state_floats(r);
-    if (r->shadow_set.technique == UMBRA_SHADOW_CSSM) {
-        const uint32_t ch = r->channels;
-        for (size_t i = 0; i < floats; ++i)
-            if (!(s[i] >= 0.0f))
-                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                   "%s: texel %zu (%zu, %zu): optical depth %g of channel %zu "
-                                   "must be >= 0 (cssm's state: one per light channel)",
-                                   fn, i / ch, i / ch % n, i / ch / n, s[i], i % ch);
-        return UMBRA_SUCCESS;
-    }
-    for (size_t i = 0; i < floats; i += STATE_FLOATS)
-        if (!(s[i] >= 0.0f && s[i] <= 1.0f) || !(s[i + 1] >= 0.0f))
+    const uint32_t per = state_floats(r, light);
+    for (size_t i = 0; i < (size_t)n * n * per; ++i) {
+        const uint32_t k = state_slot(light, i);
+        if (!(s[i] >= light->lo[k] && s[i] <= light->hi[k]))
             return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: texel %zu (%zu, %zu): state (%g, %g) must have a "
-                               "transmittance product in [0, 1] and an optical depth >= 0",
-                               fn, i / STATE_FLOATS, i / STATE_FLOATS % n, i / STATE_FLOATS / n,
-                               s[i], s[i + 1]);
+                               "%s: texel %zu (%zu, %zu): %s %g (state float %zu) must lie in "
+                               "[%g, %g] (technique %s's march state)", fn, i / per,
+                               i / per % n, i / per / n, light->name[k], (double)s[i], i % per,
+                               (double)light->lo[k], (double)light->hi[k],
+                               umbra_shadow_technique_name(light->technique));
+    }
     return UMBRA_SUCCESS;
+}
+
+static int is_deep(umbra_renderer r)
+{
+    return r->shadow_set.technique == UMBRA_SHADOW_DEEP;
 }
 
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
     const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
     return umbra__fail(r->ctx, UMBRA_ERROR_UNSUPPORTED,
-                       "%s: technique %s has no light exchange between parts (none, threshold "
-                       "and cssm have)", fn, tech ? tech : "?");
+                       "%s: technique %s has no light exchange between parts (none, "
+                       "threshold, cssm and deep have)", fn, tech ? tech : "?");
 }
 
 /* The light inputs brought up to date and the map size chosen, for a part whose technique
- * exchanges light (threshold, CSSM). */
+ * exchanges light (PART_LIGHTS). */
 static umbra_status light_ready(umbra_renderer r, const char *fn, uint32_t *map_size)
 {
     if (!r->volume || !r->volume->is_part || !r->tf)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "%s: set a part volume (umbra_volume_create_part) and a transfer "
                            "function first", fn);
-    if (!exchanges_depths(r->shadow_set.technique))
+    const PartLight *light = part_light(r->shadow_set.technique);
+    if (!light)
         return light_unsupported(r, fn);
-    umbra_status st = umbra__effective_tfs(r);
+    umbra_status st = is_deep(r) ? check_part_deep(r, fn) : UMBRA_SUCCESS;
+    if (st == UMBRA_SUCCESS)
+        st = umbra__effective_tfs(r);
     if (st != UMBRA_SUCCESS)
         return st;
     umbra__frame_update_light(r);
@@ -417,7 +477,9 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
 {
     umbra_context ctx = r->ctx;
     umbra_status st = UMBRA_SUCCESS;
-    const size_t floats = (size_t)n * n * state_floats(r), bytes = floats * sizeof(float);
+    const PartLight *light = part_light(r->shadow_set.technique);
+    const uint32_t per = state_floats(r, light);
+    const size_t floats = (size_t)n * n * per, bytes = floats * sizeof(float);
     if (r->part_state_in && r->part_state_floats != floats)
         return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
                            "umbra_renderer_render_part: the imported transmittance holds %zu "
@@ -429,7 +491,8 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
         if (!(init = malloc(bytes)))
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
                                "umbra_renderer_render_part");
-        state_start(r, init, floats);
+        for (size_t i = 0; i < floats; ++i)
+            init[i] = light->start[state_slot(light, i)];
         src = init;
     }
     size_t have = 0;
@@ -465,10 +528,11 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
     umbra_status st = light_ready(r, __func__, &n);
     if (st != UMBRA_SUCCESS)
         return st;
-    out->kind = UMBRA_PART_LIGHT_TAU_DEPTH;
+    const PartLight *light = part_light(r->shadow_set.technique);
+    out->kind = light->shares == SHARES_PIECES ? UMBRA_PART_LIGHT_TAU : UMBRA_PART_LIGHT_TAU_DEPTH;
     out->map_size = n;
-    out->channels = state_floats(r);
-    out->depth_channels = depth_floats(r);
+    out->channels = state_floats(r, light);
+    out->depth_channels = depth_floats(r, light);
     out->tau_floats = (size_t)n * n * out->channels;
     out->depth_floats = (size_t)n * n * out->depth_channels;
     return UMBRA_SUCCESS;
@@ -499,14 +563,19 @@ static umbra_status export_light(umbra_renderer r, const char *fn, float *out, i
     umbra_context ctx = r->ctx;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto fail;
-    if (depths) {
-        st = umbra__map_read(r, out, (size_t)n * n * depth_floats(r) * sizeof(float));
+    const PartLight *light = part_light(r->shadow_set.technique);
+    if (depths && light->shares == SHARES_PIECES) {
+        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: technique deep exchanges pieces of its map, not depths "
+                         "(umbra_renderer_part_export_deep)", fn);
+    } else if (depths) {
+        st = umbra__map_read(r, out, (size_t)n * n * depth_floats(r, light) * sizeof(float));
     } else if (!r->part_state_buf) {
         st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "%s: no march state was built", fn);
     } else {
         UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->part_state_buf, CL_TRUE, 0,
-                                     (size_t)n * n * state_floats(r) * sizeof(float), out, 0,
-                                     NULL, NULL));
+                                     (size_t)n * n * state_floats(r, light) * sizeof(float), out,
+                                     0, NULL, NULL));
     }
 fail:
     umbra__call_end(r);
@@ -527,10 +596,11 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
     umbra_status st = light_ready(r, fn, &n);
     if (st != UMBRA_SUCCESS)
         return st;
-    const size_t floats = (size_t)n * n * state_floats(r);
+    const PartLight *light = part_light(r->shadow_set.technique);
+    const size_t floats = (size_t)n * n * state_floats(r, light);
     float *copy = NULL;
     if (tau_in) {
-        if ((st = state_check(r, fn, tau_in, n)) != UMBRA_SUCCESS)
+        if ((st = state_check(r, light, fn, tau_in, n)) != UMBRA_SUCCESS)
             return st;
         if (!(copy = malloc(floats * sizeof *copy)))
             return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);
@@ -562,7 +632,14 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         return st;
     if ((st = build(r, fn, &n)) != UMBRA_SUCCESS)
         goto done;
-    const size_t ch = depth_floats(r);
+    const PartLight *light = part_light(r->shadow_set.technique);
+    if (light->shares == SHARES_PIECES) {
+        st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                         "%s: technique deep imports pieces of its map, not depths "
+                         "(umbra_renderer_part_import_deep)", fn);
+        goto done;
+    }
+    const size_t ch = depth_floats(r, light);
     for (size_t i = 0; i < (size_t)n * n * ch; ++i)
         if (isnan(depths[i])) {
             st = umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -575,6 +652,60 @@ umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *de
         r->part_depths_valid = 1;
     }
 done:
+    umbra__call_end(r);
+    return st;
+}
+
+/* ---- the deep map's pieces ----------------------------------------------------------------- */
+
+static umbra_status deep_ready(umbra_renderer r, const char *fn, uint32_t *n)
+{
+    if (!is_deep(r))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: the technique is %s, not deep", fn,
+                           umbra_shadow_technique_name(r->shadow_set.technique));
+    return build(r, fn, n);
+}
+
+umbra_status umbra_renderer_part_export_deep(umbra_renderer r, uint32_t *counts, float *nodes,
+                                             size_t *node_count)
+{
+    CHECK_R();
+    const char *fn = __func__;
+    if (!counts || !node_count)
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: counts (%p) and node_count (%p) must not be NULL", fn,
+                           (void *)counts, (void *)node_count);
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    uint32_t n = 0;
+    if ((st = deep_ready(r, fn, &n)) == UMBRA_SUCCESS)
+        st = umbra__deep_part_export(r, counts, nodes, node_count);
+    umbra__call_end(r);
+    return st;
+}
+
+umbra_status umbra_renderer_part_import_deep(umbra_renderer r, uint32_t parts,
+                                             const uint32_t *counts, const float *nodes,
+                                             size_t node_count)
+{
+    CHECK_R();
+    const char *fn = __func__;
+    if (parts == 0 || !counts || (node_count && !nodes))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: parts %u must be > 0, counts (%p) non-NULL and nodes (%p) "
+                           "non-NULL for %zu nodes", fn, parts, (void *)counts, (void *)nodes,
+                           node_count);
+    umbra_status st = umbra__call_begin(r, fn);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    uint32_t n = 0;
+    if ((st = deep_ready(r, fn, &n)) == UMBRA_SUCCESS &&
+        (st = umbra__deep_part_import(r, parts, counts, nodes, node_count)) == UMBRA_SUCCESS) {
+        r->part_depths_at = r->rebuilds.shadow;
+        r->part_depths_valid = 1;
+    }
     umbra__call_end(r);
     return st;
 }

@@ -3,7 +3,9 @@
  *
  * Everything is collective and every failure is agreed (umbra_mpi_agree) before the next
  * exchange, so a rank that fails never leaves the others waiting in a collective it will not
- * enter. Only MPI's own collectives move data: MPI_Exscan and MPI_Allreduce for the light,
+ * enter. Only MPI's own collectives move data: the march state down the ranks in light order
+ * (MPI_Send / MPI_Recv), MPI_Allreduce (depths) and MPI_Allgather(v) (the deep map's pieces) for
+ * the light,
  * MPI_Reduce_scatter_block with a non-commutative MPI_Op for the view (the operands of a
  * non-commutative reduction are combined in rank order, so the ranks of the communicator are put
  * in view order first), MPI_Gather(v) to collect at the root. Two chains pass data from rank to
@@ -366,6 +368,85 @@ umbra_status umbra_mpi_order(MPI_Comm comm, umbra_context ctx, const umbra_part_
 
 /* ---- light -------------------------------------------------------------------------------- */
 
+/* The deep map's pieces: each rank's node counts per texel and its nodes (after the chain of
+ * the visibility in light order built them), gathered on every rank (MPI_Allgather of the counts
+ * and the node totals, MPI_Allgatherv of the nodes) and merged there into its map. Together
+ * they are about one device's map (the nodes of every texel once, plus a node where a ray
+ * crosses into another part), which is what each rank then holds; docs/distributed.md. */
+static umbra_status exchange_pieces(MPI_Comm comm, MPI_Comm ordered, umbra_context ctx,
+                                    umbra_renderer r, const umbra_part_light_info *info,
+                                    umbra_mpi_stats *stats)
+{
+    const size_t texels = (size_t)info->map_size * info->map_size, nf = 1 + info->channels;
+    int size = 1;
+    MPI_Comm_size(ordered, &size);
+    uint32_t *counts = malloc(texels * sizeof *counts);
+    uint32_t *all_counts = malloc((size_t)size * texels * sizeof *all_counts);
+    long long *totals = malloc((size_t)size * sizeof *totals);
+    int *recv = malloc((size_t)size * sizeof *recv), *displs = malloc((size_t)size * sizeof *displs);
+    float *nodes = NULL, *all_nodes = NULL;
+    size_t mine = 0, total = 0;
+    double t = now_ms();
+    umbra_status st = UMBRA_SUCCESS;
+    if (!counts || !all_counts || !totals || !recv || !displs || texels > INT_MAX)
+        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                  "umbra_mpi_light: cannot allocate the deep map's counts (%zu texels, %d ranks)",
+                  texels, size);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_part_export_deep(r, counts, NULL, &mine);
+    if (st == UMBRA_SUCCESS && !(nodes = malloc((mine ? mine : 1) * nf * sizeof *nodes)))
+        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                  "umbra_mpi_light: cannot allocate the piece's %zu nodes", mine);
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_part_export_deep(r, counts, nodes, &mine);
+    if (stats)
+        stats->build_ms += now_ms() - t;
+    st = agree(comm, ctx, st);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    t = now_ms();
+    const long long floats = (long long)(mine * nf);
+    MPI_Allgather(&floats, 1, MPI_LONG_LONG, totals, 1, MPI_LONG_LONG, ordered);
+    long long sum = 0;
+    for (int i = 0; i < size; ++i) {
+        displs[i] = (int)sum;
+        recv[i] = (int)totals[i];
+        sum += totals[i];
+    }
+    total = (size_t)sum / nf;
+    if (sum > INT_MAX)
+        st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                  "umbra_mpi_light: the deep map's pieces hold %lld floats, more than one "
+                  "MPI_Allgatherv moves (2^31)", sum);
+    else if (!(all_nodes = malloc((size_t)(sum ? sum : 1) * sizeof *all_nodes)))
+        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                  "umbra_mpi_light: cannot allocate the gathered pieces (%lld floats)", sum);
+    st = agree(comm, ctx, st);
+    if (st != UMBRA_SUCCESS)
+        goto fail;
+    MPI_Allgather(counts, (int)texels, MPI_UINT32_T, all_counts, (int)texels, MPI_UINT32_T,
+                  ordered);
+    MPI_Allgatherv(nodes, (int)floats, MPI_FLOAT, all_nodes, recv, displs, MPI_FLOAT, ordered);
+    if (stats) {
+        stats->light_exchange_ms += now_ms() - t;
+        stats->bytes_sent += sizeof floats + texels * sizeof *counts + (size_t)floats * sizeof(float);
+    }
+    t = now_ms();
+    st = agree(comm, ctx,
+               umbra_renderer_part_import_deep(r, (uint32_t)size, all_counts, all_nodes, total));
+    if (stats)
+        stats->build_ms += now_ms() - t;
+fail:
+    free(counts);
+    free(all_counts);
+    free(totals);
+    free(recv);
+    free(displs);
+    free(nodes);
+    free(all_nodes);
+    return st;
+}
+
 umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
                              umbra_volume volume, const umbra_light *light,
                              umbra_mpi_stats *stats)
@@ -423,26 +504,8 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
         goto fail;
     MPI_Comm_rank(ordered, &pos);
 
-    if (info.kind == UMBRA_PART_LIGHT_TAU) {
-        /* Deep map: each part's own exit transmittance, the exclusive prefix product in light
-         * order (a ray that misses a part is multiplied by its 1), imported. */
-        t = now_ms();
-        st = agree(comm, ctx, umbra_renderer_part_export_transmittance(r, tau));
-        if (stats)
-            stats->build_ms += now_ms() - t;
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-        t = now_ms();
-        MPI_Exscan(tau, tau_in, (int)info.tau_floats, MPI_FLOAT, MPI_PROD, ordered);
-        if (stats) {
-            stats->light_exchange_ms += now_ms() - t;
-            stats->bytes_sent += info.tau_floats * sizeof *tau;
-        }
-        st = agree(comm, ctx, umbra_renderer_part_import_transmittance(r, pos == 0 ? NULL : tau_in));
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-    } else if (info.tau_floats) {
-        /* Threshold map and CSSM: the march state goes on from part to part in light order
+    if (info.tau_floats) {
+        /* The march state goes on from part to part in light order
          * (import what the part before left, march, export for the next), so the parts pass it
          * down the chain of the ordered ranks. A rank that fails passes its status on instead,
          * and the chain still ends; the agreement after it reports the first failure. */
@@ -482,6 +545,9 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
         if (st != UMBRA_SUCCESS)
             goto fail;
     }
+    /* The deep map: every part's pieces to every part (umbra_renderer_part_import_deep). */
+    if (info.kind == UMBRA_PART_LIGHT_TAU)
+        st = exchange_pieces(comm, ordered, ctx, r, &info, stats);
     /* Depths: build and export, minimum over the ranks, import. */
     if (info.depth_floats) {
         t = now_ms();

@@ -55,4 +55,14 @@ umbra_status umbra__deep_set_limit(umbra_renderer r, size_t blocks);
 umbra_status umbra__deep_read(umbra_renderer r, int32_t *head, int32_t *next, uint32_t *counts,
                               float *nodes);
 
+/* A part's pieces of the unbounded map (host/part_render.c): the export writes the built map's
+ * node count per texel (map_size^2) and, unless nodes is NULL, its nodes in texel order (1 +
+ * channels floats each; *node_count their capacity in, their number out); the import merges
+ * the pieces of `parts` parts (counts: parts x map_size^2, part-major; nodes: their arrays one
+ * after another, node_count in all) per texel in depth order into the map, in blocks. */
+umbra_status umbra__deep_part_export(umbra_renderer r, uint32_t *counts, float *nodes,
+                                     size_t *node_count);
+umbra_status umbra__deep_part_import(umbra_renderer r, uint32_t parts, const uint32_t *counts,
+                                     const float *nodes, size_t node_count);
+
 #endif

@@ -9,9 +9,10 @@
  *   - each rank reading only its part of the file (umbra_volume_read_box), with ghost layers,
  *     and the value range agreed over all ranks;
  *   - the light data in light order, over the ranks renumbered in light order (MPI_Comm_split):
- *     for the deep map an exclusive prefix product of exit transmittances (MPI_Exscan,
- *     MPI_PROD); for the threshold map and CSSM the march state passed down that order, part to
- *     part; then a minimum of depths (MPI_Allreduce, MPI_MIN);
+ *     the march state (the threshold map's, the deep map's visibility) passed down that order,
+ *     part to part; then for the threshold map a minimum of depths (MPI_Allreduce, MPI_MIN),
+ *     for the deep map every rank's pieces of the map gathered on every rank (MPI_Allgather,
+ *     MPI_Allgatherv) and merged;
  *   - the view composited in visibility order: MPI_Reduce_scatter_block with a non-commutative
  *     "over" MPI_Op on a communicator whose ranks are ordered front to back, then a gather; or,
  *     sequentially, every partial image gathered and composited front to back in one place.
@@ -79,7 +80,7 @@ UMBRA_API umbra_status umbra_mpi_split(MPI_Comm comm, umbra_context ctx, const u
  * around its calls, waits included) and bytes. */
 typedef struct umbra_mpi_stats {
     double load_ms;          /* header, own box of the file, value range, part volume */
-    double light_exchange_ms;/* the prefix products and minima of the light data */
+    double light_exchange_ms;/* the light data crossing ranks (state, minima, pieces) */
     double build_ms;         /* the part's light passes (exports of transmittance and depths) */
     double render_ms;        /* the part's partial image */
     double composite_ms;     /* reduce-scatter and gather, or the sequential composite */
@@ -122,12 +123,12 @@ UMBRA_API umbra_status umbra_mpi_order(MPI_Comm comm, umbra_context ctx,
 
 /* Collective: the light passes of renderer r (its part volume, transfer functions, technique and
  * light set; volume and light the ones set on r) and the exchange between them, as
- * umbra_renderer_part_light_info says, on comm's ranks in light order: for UMBRA_PART_LIGHT_TAU
- * tau_in of each part is the product of the exit transmittances of the parts before it
- * (MPI_Exscan with MPI_PROD), imported; for UMBRA_PART_LIGHT_TAU_DEPTH each part imports the
+ * umbra_renderer_part_light_info says, on comm's ranks in light order: each part imports the
  * march state the part before it exported and exports its own for the next (MPI_Recv, MPI_Send:
- * P - 1 steps one after the other); then the depths' minimum over all ranks (MPI_Allreduce,
- * MPI_MIN), imported. Whole maps cross: a lookup near a part's rim reads texels whose rays pass
+ * P - 1 steps one after the other); then for UMBRA_PART_LIGHT_TAU_DEPTH the depths' minimum over
+ * all ranks (MPI_Allreduce, MPI_MIN), imported; for UMBRA_PART_LIGHT_TAU (the deep map) every
+ * rank's pieces of the map (MPI_Allgather of the counts, MPI_Allgatherv of the nodes), merged
+ * into each rank's map. Whole maps cross: a lookup near a part's rim reads texels whose rays pass
  * through other parts, so no rank's share is cut to its own column of parts. After it r renders its part (umbra_mpi_render). Nothing to do for
  * UMBRA_SHADOW_NONE. stats (may be NULL) gets build_ms, light_exchange_ms and bytes_sent added. */
 UMBRA_API umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,

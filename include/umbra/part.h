@@ -27,9 +27,14 @@
  *   - UMBRA_SHADOW_THRESHOLD and UMBRA_SHADOW_CSSM, after the light exchange below: their maps
  *     equal one device's map of the whole volume, depth for depth (CSSM: the same photons, seed
  *     and ray blocks, grey or coloured);
- *   - the deep map needs the same kind of exchange (the transmittance reaching a part); it
- *     returns UMBRA_ERROR_UNSUPPORTED naming the technique until it implements it
- *     (umbra_renderer_part_light_info);
+ *   - UMBRA_SHADOW_DEEP (the unbounded map, prefilter 1, a light step of at most a voxel; the
+ *     rest refused by name), after the light exchange below and the exchange of the map's
+ *     pieces (umbra_renderer_part_export_deep): at epsilon 0 its lookups equal one device's to
+ *     float rounding; at epsilon > 0 each part compresses its own piece of a texel's visibility
+ *     function, so the merged function has a node where the ray enters each part and differs
+ *     from one device's by at most 2 epsilon (both lie within epsilon of the same march;
+ *     docs/distributed.md gives the measured image differences);
+ *   - what each technique exchanges: umbra_renderer_part_light_info;
  *   - refused on a part, each with UMBRA_ERROR_UNSUPPORTED naming the reason: the exact
  *     reference (shadow rays would cross parts) and convolution (slices over the whole view
  *     depth): they do not split; moments; the projection modes (MIP, MinIP, average); volumes
@@ -135,12 +140,13 @@ UMBRA_API umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_
                                                        float *frame);
 
 /* What crosses parts along the light for the renderer's technique, in light order. The threshold
- * map and CSSM exchange light (UMBRA_PART_LIGHT_TAU_DEPTH); the deep map is refused by name for
- * now, and its kind says what it will export and import. */
+ * map and CSSM exchange UMBRA_PART_LIGHT_TAU_DEPTH, the deep map UMBRA_PART_LIGHT_TAU. */
 typedef enum umbra_part_light_kind {
     UMBRA_PART_LIGHT_NOTHING = 0,  /* no light pass (UMBRA_SHADOW_NONE): nothing to exchange */
-    UMBRA_PART_LIGHT_TAU = 1,      /* deep map: export tau_exit; import tau_in, the product of
-                                      the exit maps of the parts before this one on each ray */
+    UMBRA_PART_LIGHT_TAU = 1,      /* deep map: the visibility per texel passed on in light
+                                      order (export after import, as the threshold map's
+                                      state), then every part's pieces of the map to every part
+                                      (umbra_renderer_part_export_deep, _import_deep) */
     UMBRA_PART_LIGHT_TAU_DEPTH = 2,/* threshold map and CSSM: export the march state at the
                                       part's exit, import the state the part before it left
                                       (light order), export the depths, import their minimum
@@ -164,9 +170,12 @@ typedef struct umbra_part_light_info {
                                       whole segments' 1 - alpha and an optical depth); for CSSM
                                       the optical depth from the light per simulated light
                                       channel (1 grey, 3 coloured transmission; 0 reaching the
-                                      first part) */
+                                      first part); for the deep map the visibility per light
+                                      channel (1 reaching the first part); a deep node is
+                                      1 + channels floats */
     uint32_t depth_channels;       /* floats per texel of the depth arrays: 1 for the threshold
-                                      map, CSSM's channels (a photon depth per channel) */
+                                      map, CSSM's channels (a photon depth per channel), 0 for
+                                      the deep map (it exchanges pieces) */
     size_t tau_floats;             /* map_size^2 * channels, or 0 */
     size_t depth_floats;           /* map_size^2 * depth_channels, or 0 */
 } umbra_part_light_info;
@@ -178,7 +187,8 @@ UMBRA_API umbra_status umbra_renderer_part_light_info(umbra_renderer r,
                                                       umbra_part_light_info *out);
 
 /* Light pass 1: marches the part's own segments of every light ray (those whose midpoint its
- * core owns, at the global ray's t0 + (k + 1/2) step), going on from the imported state, and
+ * core owns, at the global ray's t0 + (k + 1/2) step; for the deep map the segments of its
+ * global depth grid), going on from the imported state, and
  * writes the state at their end per texel (info.tau_floats floats, texel (u, v) at
  * (v * map_size + u) * channels; the imported state where the ray misses the part). The state
  * is the light's from the light to the part's exit, not the part's own, so parts pass it on in
@@ -210,6 +220,33 @@ UMBRA_API umbra_status umbra_renderer_part_export_depths(umbra_renderer r, float
  * depth of the photons it stopped and the "never" depth for those stopped before it (the imported
  * optical depth passed their threshold) or after it, so the minimum is one device's map. */
 UMBRA_API umbra_status umbra_renderer_part_import_depths(umbra_renderer r, const float *depths);
+
+/* The deep map's pieces (UMBRA_PART_LIGHT_TAU). After the import of the visibility reaching
+ * it (umbra_renderer_part_import_transmittance, in light order as for the threshold map; for
+ * the deep map info.channels floats per texel, the visibility per light channel), a part's map
+ * holds per texel the nodes of the light-ray segments whose midpoint its core owns: its piece
+ * of the texel's visibility function, depths in the global light frame. Every part's lookups
+ * need the whole function of the texels its samples fall in (a texel's ray can run through a
+ * neighbour's core at the sample's depth), so the pieces of all parts are gathered and each
+ * part merges them into its map.
+ *
+ * Export: builds if needed, writes the node count of each texel (info.map_size^2 counts) and,
+ * unless nodes is NULL, the nodes in texel order (1 + info.channels floats each: depth, then
+ * visibility per channel); *node_count is the capacity of nodes in nodes (ignored for NULL)
+ * and is set to the number of nodes. A capacity below it is refused naming both. */
+UMBRA_API umbra_status umbra_renderer_part_export_deep(umbra_renderer r, uint32_t *counts,
+                                                       float *nodes, size_t *node_count);
+
+/* Import: the pieces of `parts` parts (every part's, this one's included, in any order): counts
+ * holds parts x info.map_size^2 counts (part-major, as each export wrote them), nodes their node
+ * arrays one after another (node_count nodes in all). Merged per texel in depth order (the
+ * pieces of a texel lie in disjoint depth ranges) into this part's map, laid out in blocks as a
+ * build lays them out, so the lookup is one device's. Counts that do not add up to node_count,
+ * a NaN depth or a visibility outside [0, 1] are refused naming the value. A part renders the
+ * deep map only after this import, and only while no light input has changed since. */
+UMBRA_API umbra_status umbra_renderer_part_import_deep(umbra_renderer r, uint32_t parts,
+                                                       const uint32_t *counts,
+                                                       const float *nodes, size_t node_count);
 
 /* ---- Host helpers: pure functions on the arrays above (no context, no device). ---- */
 

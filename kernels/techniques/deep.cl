@@ -341,6 +341,7 @@ typedef struct DeepTexel {
     float z_pushed;   /* depth of the last point given to the fit */
     float eps, v_stop;
     int done;
+    int owned;        /* a part (UMBRA_PART): it has marched a segment it owns */
     DeepFit fit;
 } DeepTexel;
 
@@ -384,6 +385,7 @@ inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom
     T->eps = eps;
     T->v_stop = fmax(0.5f * eps, 1e-4f);
     T->z_pushed = -UMBRA_INF;
+    T->owned = 0;
     deep_fit_init(&T->fit);
     T->done = !(tb_max > ta_min);
     T->k = T->k_end = 0;
@@ -493,6 +495,40 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     const float inv_B = 1.0f / (float)g.brick_size, inv_C = 1.0f / (float)g.cell_size;
     const int last_cell = (g.brick_size - 1) / g.cell_size;
 
+#if UMBRA_PART
+    /* A part (host/part_render.c; one sub-ray, prefilter 1) marches the segments whose midpoint
+     * its core owns, from the visibility the parts before it on the ray left (part_state):
+     * the same segments, samples and products as one device's march. The segments it owns are
+     * consecutive (the core is convex); the first one after them ends its piece. */
+    {
+        const DeepSub *s0 = &T->sub[0];
+        const float a = fmax(t0, s0->ta), b = fmin(t1, s0->tb);
+        if (!(b > a) || !part_owns(F, world_to_voxel(g, s0->o + (0.5f * (a + b)) * s0->d))) {
+            if (T->owned) {
+                deep_fit_finish(&T->fit, e, &ne);
+                T->done = 1;
+                return ne;
+            }
+            T->k++;
+            T->done = T->k >= T->k_end;
+            return 0;
+        }
+        if (!T->owned) {
+            T->owned = 1;
+            /* The piece starts at the segment's front end: the fit's origin is the visibility
+             * arriving there (the previous part's last node, at this depth); while it is 1 the
+             * origin slides along as on one device. */
+            const float z_front = (float)T->k * T->zstep;
+            T->fit.z0 = z_front;
+            if (!deep_all_one(T->sub[0].v)) {
+                T->fit.started = 1;
+                T->fit.v0 = T->sub[0].v;
+                T->fit.npts = 0;
+                T->z_pushed = z_front;
+            }
+        }
+    }
+#endif
     DeepPoints pts[DEEP_SUB_RAYS];
     light_t v_front[DEEP_SUB_RAYS]; /* each sub-ray's visibility at the segment's front end */
     light_t v_start = (light_t)(0.0f), v_end = (light_t)(0.0f);
@@ -682,6 +718,28 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
  * most blocks the device could ever hold) stops at once: the host then reports the map as too
  * large without the rest of the build's work. Every work-item reaches every barrier (texels
  * outside the map take part with nothing to march). */
+#if UMBRA_PART
+/* A part's light state per texel: the visibility of the texel's ray, UMBRA_LIGHT_CHANNELS
+ * floats (host/part_render.c). */
+inline light_t deep_state_load(__global const float *state, int texel)
+{
+#if UMBRA_LIGHT_CHANNELS == 1
+    return state[texel];
+#else
+    return vload3(texel, state);
+#endif
+}
+
+inline void deep_state_store(__global float *state, int texel, light_t v)
+{
+#if UMBRA_LIGHT_CHANNELS == 1
+    state[texel] = v;
+#else
+    vstore3(v, texel, state);
+#endif
+}
+#endif
+
 __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const float4 *view_tf, __global const float4 *light_tf,
                          __global const uchar *view_bricks, __global const ulong *light_cells,
@@ -689,7 +747,11 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
                          __global const deep_node *lut, uint use_lut, float eps,
                          __global deep_node *nodes,
                          __global int *head, __global int *next, __global uint *counts,
-                         volatile __global uint *counter, uint capacity, uint limit)
+                         volatile __global uint *counter, uint capacity, uint limit
+#if UMBRA_PART
+                         , __global float *part_state
+#endif
+                         )
 {
     (void)view_tf;
     (void)view_bricks;
@@ -708,8 +770,16 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
 
     DeepTexel st;
     st.done = 1;
-    if (gx < n && gy < n)
+    if (gx < n && gy < n) {
         deep_texel_init(&st, S, g, (int2)(gx, gy), eps);
+#if UMBRA_PART
+        /* The visibility reaching the part on this ray (host/part_render.c); a ray whose light
+         * fell below the march's stop before it is done, as one device's march stopped. */
+        st.sub[0].v = deep_state_load(part_state, gy * n + gx);
+        if (light_max(st.sub[0].v) < st.v_stop)
+            st.done = 1;
+#endif
+    }
     deep_node pend[DEEP_MAX_EMIT];
     int npend = 0, ppos = 0;
     uint written = 0, layer_end = 0;
@@ -763,8 +833,12 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
             ++written;
         }
     }
-    if (gx < n && gy < n)
+    if (gx < n && gy < n) {
         counts[gy * n + gx] = written;
+#if UMBRA_PART
+        deep_state_store(part_state, gy * n + gx, st.sub[0].v);
+#endif
+    }
 }
 
 /* deep_build_fixed, the build with a fixed node budget, is in kernels/techniques/deep_budget.cl

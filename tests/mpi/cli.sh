@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # tests/mpi/cli.sh MPIEXEC UMBRA_RENDER_MPI UMBRA_RENDER IMAGE_DIFF: umbra-render-mpi on 4 ranks
 # (2x2x1) against umbra-render on a generated volume file, for none, threshold, CSSM and deep
-# (EXR images, early termination off: --termination 1), and --composite chain bit for bit for
-# none, threshold and CSSM; the stats name every rank; the techniques
+# (deep at epsilon 0 and 0.02; EXR images, early termination off: --termination 1), and
+# --composite chain bit for bit for none, threshold and CSSM; the stats name every rank; the techniques
 # that do not split and a grid that does not tile are refused with one message, exit status 1.
 set -euo pipefail
 mpiexec=$1 mpi=$2 one=$3 diff=$4
@@ -33,16 +33,16 @@ PY
 
 common=(--volume "$work/blobs.nhdr" --size 64x48 --no-ground --termination 1 --shading
         --light-dir 0.3,-1,0.4 --map-size 128)
-for t in none threshold cssm deep; do
+# The deep map at epsilon 0 (bound 1e-5) and at its default 0.02 (each part's compression
+# restarts where the light enters it: bound 1e-2, docs/distributed.md).
+for t in none threshold cssm deep deep:0.02; do
   bound=1e-5; [ "$t" = none ] && bound=1e-6
-  "$one" "${common[@]}" --technique "$t" -o "$work/one_$t.exr" 2>/dev/null ||
+  tech=(--technique "${t%%:*}")
+  [ "$t" = deep ] && tech+=(--epsilon 0)
+  [ "$t" = deep:0.02 ] && { tech+=(--epsilon 0.02); bound=1e-2; t=deep_eps; }
+  "$one" "${common[@]}" "${tech[@]}" -o "$work/one_$t.exr" 2>/dev/null ||
     fail "umbra-render --technique $t"
-  if ! run4 --grid 2x2x1 "${common[@]}" --technique "$t" -o "$work/mpi_$t.exr" 2>"$work/log_$t"; then
-    # A technique the part-aware core does not exchange yet is refused by name: shown, not failed.
-    if [ "$t" = deep ] && grep -q UNSUPPORTED "$work/log_$t"; then
-      echo "$t: SKIP: $(grep -m1 UNSUPPORTED "$work/log_$t")"
-      continue
-    fi
+  if ! run4 --grid 2x2x1 "${common[@]}" "${tech[@]}" -o "$work/mpi_$t.exr" 2>"$work/log_$t"; then
     cat "$work/log_$t" >&2
     fail "umbra-render-mpi --technique $t"
   fi
