@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* bench/raycast.c: `umbra-bench raycast`, the foundation's speed check.
+ * Why one file past 800 lines: one benchmark, whose options, frames taken in turns and report
+ * share one scene and view.
  *
  * One view of each scene, the bonsai CT (or its procedural stand-in, bench_util.c; 8-bit) and the
  * walnut CT (16-bit; skipped when its file is missing), at 512x512, view step 0.5 voxel, no

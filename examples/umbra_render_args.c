@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-/* examples/umbra_render_args.c: umbra-render's command line. getopt_long over two tables: the
+/* examples/umbra_render_args.c: umbra-render's command line.
+ * Why one file past 800 lines: one parser, whose option tables, checks and --help read the same
+ * tables. getopt_long over two tables: the
  * fixed options below, and one option per parameter of every shadow technique, made from the
  * technique registry (umbra/registry.h): --<key> with '_' written '-' (--map-size, --taps,
  * --reference-step), the parameter's older spelling where it has one (--nodes, --cone-angle), and

@@ -7,12 +7,14 @@
  * and brick visibility are keyed by (table id, volume id, step); the shadow structure by the full
  * light key (umbra__light_key); programs by their sources and options (context cache). The
  * tables live in host/tables.c, the frame constants in host/frame.c, rendering into the
- * application's cl_mem in host/render_cl.c, progress and banded launches in host/progress.c. */
+ * application's cl_mem in host/render_cl.c, progress and banded launches in host/progress.c, the
+ * gradient volume in host/gradient_volume.c, umbra_renderer_query_shadow in host/query_shadow.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gradient_volume.h"
 #include "preintegration.h"
 #include "renderer_internal.h"
 
@@ -405,7 +407,7 @@ umbra_status umbra_renderer_set_shadow(umbra_renderer r, const umbra_shadow_desc
 
 /* ---- the frame ---------------------------------------------------------------------------------------- */
 
-static umbra_status check_ready(umbra_renderer r, const char *fn)
+umbra_status umbra__check_ready(umbra_renderer r, const char *fn)
 {
     if (!r->volume || !r->tf)
         return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
@@ -544,7 +546,7 @@ void umbra__choose_local(umbra_renderer r, cl_kernel k, size_t local[2])
         local[0] = 32;
 }
 
-static umbra_status ensure_kernels(umbra_renderer r)
+umbra_status umbra__raycast_kernels(umbra_renderer r)
 {
     char options[256];
     /* common/lightspace.cl: the map projection the light-space techniques' lookups need. */
@@ -578,60 +580,6 @@ static umbra_timing measured_timing(umbra_renderer r)
     return r->ctx->profiling ? UMBRA_TIMING_DEVICE : UMBRA_TIMING_WALL;
 }
 
-/* The shading gradient volume for this frame (kernels/common/sampling.cl, gradient_volume_entry):
- * *on is 1 and *buf the volume's gradients where the frame shades a plain whole volume of
- * integers in one buffer whose (dims + 3)^3 entries of 8 bytes fit one allocation, made again when the volume, its
- * version or the program changed; else *on is 0, *buf any buffer, and a gradient volume held
- * is released (only shaded frames pay its memory). The kernel reads it in place of the 32-voxel
- * stencil, the same gradient bit for bit. */
-static umbra_status gradient_volume(umbra_renderer r, cl_mem *buf, cl_uint *on)
-{
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    const umbra_volume v = r->volume;
-    *buf = r->view_tf_buf;
-    *on = 0;
-    const uint64_t n[3] = {(uint64_t)v->dims[0] + 3, (uint64_t)v->dims[1] + 3,
-                           (uint64_t)v->dims[2] + 3};
-    const uint64_t bytes = n[0] * n[1] * n[2] * 8u;
-    /* int16 differences are exact for integer voxels loaded as stored that span <= 32767 */
-    const int exact = !v->clamps && v->stored_form == UMBRA__STORED_RAW &&
-                      (v->stored_type == UMBRA_UINT8 ||
-                       ((v->stored_type == UMBRA_UINT16 || v->stored_type == UMBRA_INT16) &&
-                        (double)v->value_max - (double)v->value_min <= 32767.0));
-    umbra__device_limits lim;
-    int wanted = r->opts.shading && r->grad_kernel && exact && !umbra__volume_images(v) &&
-                 v->slab_count == 1 && !v->is_part && !v->labels && v->channels <= 1;
-    if (wanted && (umbra__device_limits_get(ctx, 0, &lim) != UMBRA_SUCCESS ||
-                   bytes > lim.max_alloc || bytes > SIZE_MAX))
-        wanted = 0;
-    const uint64_t key[3] = {v->id, v->version, (uint64_t)(uintptr_t)r->program};
-    if (!wanted || (r->grad_buf && memcmp(key, r->grad_key, sizeof key) != 0))
-        umbra__release_mem(&r->grad_buf);
-    if (!wanted)
-        return UMBRA_SUCCESS;
-    if (!r->grad_buf) {
-        cl_int err;
-        r->grad_buf = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_WRITE, (size_t)bytes, NULL, &err);
-        UMBRA_CL_CHECK(err, "clCreateBuffer");
-        /* raycast_gradient_volume(F, vol, out), after the frame's wait list */
-        UMBRA_CL(clSetKernelArg(r->grad_kernel, 0, sizeof(cl_mem), &r->frame_buf));
-        UMBRA_CL(clSetKernelArg(r->grad_kernel, 1, sizeof(cl_mem), &v->slabs[0]));
-        UMBRA_CL(clSetKernelArg(r->grad_kernel, 2, sizeof(cl_mem), &r->grad_buf));
-        const size_t global[3] = {(size_t)n[0], (size_t)n[1], (size_t)n[2]};
-        if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS ||
-            (st = umbra__enqueue(ctx, r->grad_kernel, 3, global, NULL, NULL)) != UMBRA_SUCCESS)
-            goto fail;
-        memcpy(r->grad_key, key, sizeof key);
-    }
-    *buf = r->grad_buf;
-    *on = 1;
-fail:
-    if (st != UMBRA_SUCCESS)
-        umbra__release_mem(&r->grad_buf);
-    return st;
-}
-
 /* Sets every argument of the ray caster for a frame into out. */
 static umbra_status bind_raycast(umbra_renderer r, cl_mem out, const char *fn)
 {
@@ -658,7 +606,7 @@ static umbra_status bind_raycast(umbra_renderer r, cl_mem out, const char *fn)
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &r->view_cells_buf));
     cl_mem grad;
     cl_uint grad_on;
-    if ((st = gradient_volume(r, &grad, &grad_on)) != UMBRA_SUCCESS)
+    if ((st = umbra__gradient_volume(r, &grad, &grad_on)) != UMBRA_SUCCESS)
         return st;
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof(cl_mem), &grad));
     UMBRA_CL(clSetKernelArg(r->render_kernel, next++, sizeof grad_on, &grad_on));
@@ -674,7 +622,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
 {
     const char *fn = "umbra_renderer_render";
     umbra_context ctx = r->ctx;
-    umbra_status st = check_ready(r, fn);
+    umbra_status st = umbra__check_ready(r, fn);
     cl_event ev = NULL;
     if (st == UMBRA_SUCCESS && r->volume->is_part && !r->part_call)
         return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
@@ -711,7 +659,7 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
         return st;
     }
     const int composite = r->opts.mode == UMBRA_RENDER_COMPOSITE;
-    st = composite ? ensure_kernels(r) : UMBRA_SUCCESS;
+    st = composite ? umbra__raycast_kernels(r) : UMBRA_SUCCESS;
     if (st == UMBRA_SUCCESS)
         st = umbra__ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
     if (st == UMBRA_SUCCESS)
@@ -802,85 +750,6 @@ umbra_status umbra_renderer_render(umbra_renderer r, uint32_t width, uint32_t he
     umbra_status st = umbra__call_begin(r, __func__);
     if (st == UMBRA_SUCCESS) {
         st = render_host(r, width, height, rgba);
-        umbra__call_end(r);
-    }
-    return st;
-}
-
-static umbra_status query_shadow(umbra_renderer r, const float *points, size_t count, float *rgb)
-{
-    const char *fn = "umbra_renderer_query_shadow";
-    umbra_context ctx = r->ctx;
-    umbra_status st = UMBRA_SUCCESS;
-    cl_mem in = NULL, outb = NULL;
-    float *moved = NULL;
-    if (!points || !rgb || count == 0 || count > (1u << 28))
-        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: points %p, rgb %p, count %zu: need both buffers and 1..2^28 points",
-                           fn, (const void *)points, (void *)rgb, count);
-    if ((st = check_ready(r, fn)) != UMBRA_SUCCESS ||
-        (st = umbra__effective_tfs(r)) != UMBRA_SUCCESS)
-        return st;
-    if (!r->tech->kernel_files)
-        return umbra__fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                           "%s: technique '%s' has no per-point shadow lookup", fn,
-                           r->tech->info.name);
-    umbra__progress_begin(r);
-    if ((st = umbra__prepare_shadow(r, 0.5, 0)) != UMBRA_SUCCESS)
-        return st;
-    umbra__progress_phase(r, r->progress_last, 1.0);
-    if ((st = ensure_kernels(r)) != UMBRA_SUCCESS)
-        return st;
-    /* The points are in the volume's world; the kernel takes them in its local frame. */
-    const float *local = points;
-    if (r->volume->transformed) {
-        if (!(moved = malloc(count * 3 * sizeof *moved)))
-            return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                               "%s: out of host memory for %zu points", fn, count);
-        for (size_t i = 0; i < count; ++i)
-            umbra__volume_point_to_local(r->volume, points + 3 * i, moved + 3 * i);
-        local = moved;
-    }
-    cl_int err;
-    in = clCreateBuffer(ctx->cl_ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, count * 12,
-                        (void *)local, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(points)");
-    outb = clCreateBuffer(ctx->cl_ctx, CL_MEM_WRITE_ONLY, count * 12, NULL, &err);
-    UMBRA_CL_CHECK(err, "clCreateBuffer(rgb)");
-    if ((st = umbra__upload_params(r)) != UMBRA_SUCCESS)
-        goto fail;
-    cl_uint next = 0, n = (cl_uint)count;
-    if ((st = umbra__bind_common(r, r->query_kernel, &next)) != UMBRA_SUCCESS)
-        goto fail;
-    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_mem), &in));
-    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_mem), &outb));
-    UMBRA_CL(clSetKernelArg(r->query_kernel, next++, sizeof(cl_uint), &n));
-    if (r->tech->bind && (st = r->tech->bind(r, r->query_kernel, next)) != UMBRA_SUCCESS)
-        goto fail;
-    /* In bands like a render: a shadow query of the reference marches a shadow ray per point. */
-    const size_t global[2] = {count, 1};
-    size_t group[2] = {64, 1};
-    const double cost = umbra__march_cost(r, 0);
-    double ms = 0.0;
-    umbra__band_local(r, cost, group);
-    if ((st = umbra__run_2d(r, r->query_kernel, global, group, cost, &ms, fn)) != UMBRA_SUCCESS)
-        goto fail;
-    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, outb, CL_TRUE, 0, count * 12, rgb, 0, NULL, NULL));
-    umbra__progress_end(r);
-fail:
-    free(moved);
-    umbra__release_mem(&in);
-    umbra__release_mem(&outb);
-    return st;
-}
-
-umbra_status umbra_renderer_query_shadow(umbra_renderer r, const float *points, size_t count,
-                                         float *rgb)
-{
-    CHECK_R();
-    umbra_status st = umbra__call_begin(r, __func__);
-    if (st == UMBRA_SUCCESS) {
-        st = query_shadow(r, points, count, rgb);
         umbra__call_end(r);
     }
     return st;

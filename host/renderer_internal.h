@@ -180,12 +180,12 @@ struct umbra_renderer_t {
     cl_kernel render_kernel, query_kernel;
     /* The shading gradient volume (kernels/common/sampling.cl, gradient_volume_entry) and its
      * build kernel, from the ray caster's program: made for shaded frames of a plain whole
-     * volume in one buffer (host/renderer.c, gradient_volume), for the volume id, version and
+     * volume in one buffer (host/gradient_volume.c), for the volume id, version and
      * program in grad_key; released for a frame without shading. */
     cl_kernel grad_kernel;
     cl_mem grad_buf;
     uint64_t grad_key[3];
-    size_t render_local[2];                  /* raycast_render's work-group (ensure_kernels) */
+    size_t render_local[2]; /* raycast_render's work-group (umbra__raycast_kernels) */
     struct umbra__preint *preint;            /* pre-integrated ray casting's table, or NULL */
     /* The view and light transfer functions as the volume's normalised range sees them
      * (umbra__tf_for_volume: the set ones, or resampled from their data range), and the
@@ -323,6 +323,15 @@ void umbra__projection_release(umbra_renderer r);
 /* The ray caster's work-group for kernel k: 32 x 8 where the kernel and device allow 256, else
  * 8 x 8 (host/renderer.c). */
 void umbra__choose_local(umbra_renderer r, cl_kernel k, size_t local[2]);
+
+/* Refuses a call named fn on a renderer without a volume and a transfer function, or whose
+ * technique cannot render the volume's kind (host/renderer.c). */
+umbra_status umbra__check_ready(umbra_renderer r, const char *fn);
+
+/* The ray caster's program for the current technique and options, and its kernels
+ * (r->render_kernel, query_kernel, grad_kernel), made again when the program changes
+ * (host/renderer.c). */
+umbra_status umbra__raycast_kernels(umbra_renderer r);
 
 /* r->shadow_params.clip from the clip region set and the volume's placement (host/clip.c);
  * called by umbra__frame_update_light. */

@@ -98,7 +98,9 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
                                     cl_mem *buf)
 {
     const int light = step_voxels == 0.0f;
-    size_t bytes = (size_t)tf->count * 4 * sizeof(float) * (light ? 4 : 1);
+    /* The view table has one entry more, a copy of the last (tf_classify in
+     * kernels/common/sampling.cl reads entry i + 1 for i up to count - 1 without a clamp). */
+    size_t bytes = ((size_t)tf->count * (light ? 4 : 1) + (light ? 0 : 1)) * 4 * sizeof(float);
     float *t = malloc(bytes);
     if (!t) /* upload_table reports it */
         return upload_table(r, NULL, bytes, "corrected transfer function", buf);
@@ -109,6 +111,8 @@ static umbra_status corrected_table(umbra_renderer r, umbra_transfer_function tf
                        : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
                                  : 1.0f;
     }
+    if (!light)
+        memcpy(t + 4 * (size_t)tf->count, t + 4 * ((size_t)tf->count - 1), 4 * sizeof(float));
     if (light) {
         double sum[4] = {0, 0, 0, 0}, d[4];
         float *p = t + 4 * (size_t)tf->count;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* tests/test_gradient_volume.c: the ray caster's gradient volume (kernels/common/sampling.cl,
- * gradient_volume_entry; host/renderer.c, gradient_volume), pinned down.
+ * gradient_volume_entry; host/gradient_volume.c), pinned down.
  *
  *  - a shaded frame from the gradient volume equals, bit for bit, the same frame shaded from the
  *    32-voxel stencil (the gradient volume refused by a lowered allocation limit), on uint8 and

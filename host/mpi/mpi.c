@@ -1,17 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-/* host/mpi/mpi.c: umbra_mpi (include/umbra/mpi.h), the communication around libumbra's parts.
+/* host/mpi/mpi.c: umbra_mpi (include/umbra/mpi.h), the communication around libumbra's parts:
+ * the agreement, the split, the load, the orders and the light; the image composites are in
+ * host/mpi/composite.c.
  *
  * Everything is collective and every failure is agreed (umbra_mpi_agree) before the next
  * exchange, so a rank that fails never leaves the others waiting in a collective it will not
- * enter. Only MPI's own collectives move data: the march state down the ranks in light order
- * (MPI_Send / MPI_Recv), MPI_Allreduce (depths) and MPI_Allgather(v) (the deep map's pieces) for
- * the light,
- * MPI_Reduce_scatter_block with a non-commutative MPI_Op for the view (the operands of a
- * non-commutative reduction are combined in rank order, so the ranks of the communicator are put
- * in view order first), MPI_Gather(v) to collect at the root. Two chains pass data from rank to
- * rank in light or view order instead (MPI_Send, MPI_Recv), where each step needs the one before:
- * the threshold and CSSM march state (umbra_mpi_light) and the frame of
- * UMBRA_MPI_COMPOSITE_CHAIN (render_chain). */
+ * enter. Only MPI's own collectives move data here: MPI_Allreduce (the value range, depths),
+ * MPI_Allgather(v) (the parts, the deep map's pieces) and MPI_Comm_split (the ranks renumbered
+ * in light or view order). One chain passes data from rank to rank in light order instead
+ * (MPI_Send, MPI_Recv), where each step needs the one before: the threshold and CSSM march
+ * state (umbra_mpi_light). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <limits.h>
@@ -21,9 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "umbra/mpi.h"
-
-#define MSG UMBRA_MPI_MESSAGE_MAX
+#include "mpi_internal.h"
 
 static umbra_status note(char *buf, umbra_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -73,10 +69,7 @@ umbra_status umbra_mpi_agree(MPI_Comm comm, umbra_context ctx, umbra_status loca
     return (umbra_status)agreed.status;
 }
 
-/* Records status and a formatted message on ctx (NULL: dropped) and returns status. */
-static umbra_status fail(umbra_context ctx, umbra_status status, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static umbra_status fail(umbra_context ctx, umbra_status status, const char *fmt, ...)
+umbra_status umbra__mpi_fail(umbra_context ctx, umbra_status status, const char *fmt, ...)
 {
     char text[MSG];
     va_list ap;
@@ -84,12 +77,6 @@ static umbra_status fail(umbra_context ctx, umbra_status status, const char *fmt
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
     return umbra_context_record_error(ctx, status, text);
-}
-
-/* Agrees st with ctx's last message as the local one. */
-static umbra_status agree(MPI_Comm comm, umbra_context ctx, umbra_status st)
-{
-    return umbra_mpi_agree(comm, ctx, st, NULL, NULL, 0);
 }
 
 void umbra_mpi_split_desc_init(umbra_mpi_split_desc *desc)
@@ -198,11 +185,6 @@ static void core_range(const void *voxels, umbra_scalar_type type, const umbra_p
     *hi = mx;
 }
 
-static double now_ms(void)
-{
-    return MPI_Wtime() * 1e3;
-}
-
 umbra_status umbra_mpi_load(MPI_Comm comm, umbra_context ctx, const char *path,
                             const umbra_volume_box_desc *file, const umbra_mpi_split_desc *split,
                             const float *range, umbra_mpi_volume *out, umbra_mpi_stats *stats)
@@ -226,9 +208,9 @@ umbra_status umbra_mpi_load(MPI_Comm comm, umbra_context ctx, const char *path,
     /* 1. The header, on every rank (a few hundred bytes). */
     st = umbra_volume_read_box(ctx, path, &box, &out->file, &voxels);
     if (st == UMBRA_SUCCESS && out->file.channels != 1)
-        st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                                        "umbra_mpi_load: a volume of several channels is not "
-                                        "split (a part holds one channel)");
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                             "umbra_mpi_load: a volume of several channels is not "
+                             "split (a part holds one channel)");
     st = agree(comm, ctx, st);
     if (st != UMBRA_SUCCESS)
         goto fail;
@@ -312,8 +294,8 @@ static umbra_status gather_parts(MPI_Comm comm, umbra_context ctx, const umbra_p
     *count = size;
     *all = calloc((size_t)size, sizeof **all);
     if (!*all)
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                        "umbra_mpi: cannot allocate the parts of the ranks");
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_mpi: cannot allocate the parts of the ranks");
     st = agree(comm, ctx, st);
     if (st != UMBRA_SUCCESS) {
         free(*all);
@@ -366,6 +348,33 @@ umbra_status umbra_mpi_order(MPI_Comm comm, umbra_context ctx, const umbra_part_
     return st;
 }
 
+umbra_status umbra__mpi_view_ordered(MPI_Comm comm, umbra_context ctx,
+                                     const umbra_part_desc *part,
+                                     const umbra_volume_info *placement,
+                                     const umbra_camera *camera, int root, MPI_Comm *ordered,
+                                     int *ordered_root)
+{
+    umbra_part_desc *all = NULL;
+    uint32_t *order = NULL;
+    int count = 0;
+    umbra_status st = gather_parts(comm, ctx, part, &all, &count);
+    if (st != UMBRA_SUCCESS)
+        return st;
+    order = malloc((size_t)count * sizeof *order);
+    st = order ? umbra_part_view_order(all, (uint32_t)count, placement, camera, order)
+               : UMBRA_ERROR_OUT_OF_MEMORY;
+    st = agree(comm, ctx, st);
+    if (st == UMBRA_SUCCESS)
+        st = split_in_order(comm, ctx, order, count, ordered);
+    *ordered_root = -1;
+    for (int i = 0; st == UMBRA_SUCCESS && i < count; ++i)
+        if (order[i] == (uint32_t)root)
+            *ordered_root = i;
+    free(order);
+    free(all);
+    return st;
+}
+
 /* ---- light -------------------------------------------------------------------------------- */
 
 /* The deep map's pieces: each rank's node counts per texel and its nodes (after the chain of
@@ -389,14 +398,14 @@ static umbra_status exchange_pieces(MPI_Comm comm, MPI_Comm ordered, umbra_conte
     double t = now_ms();
     umbra_status st = UMBRA_SUCCESS;
     if (!counts || !all_counts || !totals || !recv || !displs || texels > INT_MAX)
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                  "umbra_mpi_light: cannot allocate the deep map's counts (%zu texels, %d ranks)",
-                  texels, size);
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_mpi_light: cannot allocate the deep map's counts (%zu "
+                             "texels, %d ranks)", texels, size);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_part_export_deep(r, counts, NULL, &mine);
     if (st == UMBRA_SUCCESS && !(nodes = malloc((mine ? mine : 1) * nf * sizeof *nodes)))
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                  "umbra_mpi_light: cannot allocate the piece's %zu nodes", mine);
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_mpi_light: cannot allocate the piece's %zu nodes", mine);
     if (st == UMBRA_SUCCESS)
         st = umbra_renderer_part_export_deep(r, counts, nodes, &mine);
     if (stats)
@@ -415,12 +424,13 @@ static umbra_status exchange_pieces(MPI_Comm comm, MPI_Comm ordered, umbra_conte
     }
     total = (size_t)sum / nf;
     if (sum > INT_MAX)
-        st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                  "umbra_mpi_light: the deep map's pieces hold %lld floats, more than one "
-                  "MPI_Allgatherv moves (2^31)", sum);
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                             "umbra_mpi_light: the deep map's pieces hold %lld floats, more "
+                             "than one MPI_Allgatherv moves (2^31)", sum);
     else if (!(all_nodes = malloc((size_t)(sum ? sum : 1) * sizeof *all_nodes)))
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                  "umbra_mpi_light: cannot allocate the gathered pieces (%lld floats)", sum);
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_mpi_light: cannot allocate the gathered pieces (%lld "
+                             "floats)", sum);
     st = agree(comm, ctx, st);
     if (st != UMBRA_SUCCESS)
         goto fail;
@@ -465,15 +475,15 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
     info.struct_size = sizeof info;
     umbra_part_desc_init(&part);
     st = light ? umbra_renderer_part_light_info(r, &info)
-               : fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                            "umbra_mpi_light: light is NULL");
+               : umbra__mpi_fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                 "umbra_mpi_light: light is NULL");
     if (st == UMBRA_SUCCESS)
         st = umbra_volume_get_part(volume, &part);
     if (st == UMBRA_SUCCESS)
         st = umbra_volume_get_info(volume, &placement);
     if (st == UMBRA_SUCCESS && (info.tau_floats > INT_MAX || info.depth_floats > INT_MAX))
-        st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                                        "umbra_mpi_light: a map of more than 2^31 floats");
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_UNSUPPORTED,
+                             "umbra_mpi_light: a map of more than 2^31 floats");
     st = agree(comm, ctx, st);
     if (st != UMBRA_SUCCESS || info.kind == UMBRA_PART_LIGHT_NOTHING)
         return st;
@@ -488,9 +498,9 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
     tau_in = info.tau_floats ? malloc(info.tau_floats * sizeof *tau_in) : NULL;
     depth = info.depth_floats ? malloc(info.depth_floats * sizeof *depth) : NULL;
     if (!order || (info.tau_floats && (!tau || !tau_in)) || (info.depth_floats && !depth))
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                        "umbra_mpi_light: cannot allocate the maps (%zu floats)",
-                                        2 * info.tau_floats + info.depth_floats);
+        st = umbra__mpi_fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
+                             "umbra_mpi_light: cannot allocate the maps (%zu floats)",
+                             2 * info.tau_floats + info.depth_floats);
     else
         st = umbra_part_visibility_order(all, (uint32_t)count, &placement,
                                          light->type == UMBRA_LIGHT_POINT ? light->position
@@ -521,8 +531,9 @@ umbra_status umbra_mpi_light(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
             if (stats)
                 stats->light_exchange_ms += now_ms() - w;
             if (flag != 0.0f)
-                st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                          "umbra_mpi_light: a rank before this one in light order failed");
+                st = umbra__mpi_fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                     "umbra_mpi_light: a rank before this one in light order "
+                                     "failed");
         }
         t = now_ms();
         if (st == UMBRA_SUCCESS)
@@ -572,314 +583,5 @@ fail:
     free(tau);
     free(order);
     free(all);
-    return st;
-}
-
-/* ---- view --------------------------------------------------------------------------------- */
-
-/* The MPI_Op: inout = in over inout. MPI combines the operands of a non-commutative operator in
- * rank order, in (the lower ranks' partial result) and inout (the higher ones'), so with the
- * ranks in view order the reduction is front over back. */
-static void over_op(void *in, void *inout, int *len, MPI_Datatype *type)
-{
-    (void)type;
-    umbra_part_over(in, inout, inout, (size_t)*len);
-}
-
-umbra_status umbra_mpi_composite(MPI_Comm ordered, umbra_context ctx, const float *part,
-                                 const umbra_part_rect *rect, uint32_t width, uint32_t height,
-                                 const float background[4], umbra_mpi_composite_mode mode,
-                                 int root, float *image, umbra_mpi_stats *stats)
-{
-    const double t0 = now_ms();
-    const size_t pixels = (size_t)width * height;
-    int me = 0, size = 1;
-    float *frame = NULL, *piece = NULL, *all = NULL;
-    umbra_part_rect *rects = NULL;
-    int *counts = NULL, *displs = NULL;
-    umbra_status st = UMBRA_SUCCESS;
-    MPI_Comm_rank(ordered, &me);
-    MPI_Comm_size(ordered, &size);
-    const size_t block = (pixels + (size_t)size - 1) / (size_t)size;
-
-    if (mode == UMBRA_MPI_COMPOSITE_CHAIN)
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                  "umbra_mpi_composite: mode chain renders while it composites: use "
-                  "umbra_mpi_render");
-    else if (mode != UMBRA_MPI_COMPOSITE_REDUCE_SCATTER && mode != UMBRA_MPI_COMPOSITE_SEQUENTIAL)
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_composite: mode %d is unknown",
-                  (int)mode);
-    else if (!rect || (rect->width && rect->height && !part) || (me == root && !image) ||
-             width == 0 || height == 0 || root < 0 || root >= size)
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                        "umbra_mpi_composite: image %u x %u, root %d of %d ranks, "
-                                        "or a NULL rect, part or image at the root",
-                                        width, height, root, size);
-    else if ((uint64_t)rect->x + rect->width > width || (uint64_t)rect->y + rect->height > height)
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                        "umbra_mpi_composite: rect %u,%u %u x %u outside the "
-                                        "%u x %u image",
-                                        rect->x, rect->y, rect->width, rect->height, width, height);
-    else if (block * (size_t)size * 4 > INT_MAX)
-        st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                                        "umbra_mpi_composite: an image of %zu pixels over %d ranks "
-                                        "passes MPI's int counts",
-                                        pixels, size);
-    st = agree(ordered, ctx, st);
-    if (st != UMBRA_SUCCESS)
-        return st;
-
-    if (mode == UMBRA_MPI_COMPOSITE_REDUCE_SCATTER) {
-        MPI_Datatype pixel;
-        MPI_Op over;
-        frame = calloc(block * (size_t)size * 4, sizeof *frame);
-        piece = malloc(block * 4 * sizeof *piece);
-        if (!frame || !piece)
-            st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                            "umbra_mpi_composite: cannot allocate a %u x %u frame",
-                                            width, height);
-        st = agree(ordered, ctx, st);
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-        for (uint32_t y = 0; y < rect->height; ++y)
-            memcpy(frame + ((size_t)(rect->y + y) * width + rect->x) * 4,
-                   part + (size_t)y * rect->width * 4, (size_t)rect->width * 4 * sizeof *frame);
-        MPI_Type_contiguous(4, MPI_FLOAT, &pixel);
-        MPI_Type_commit(&pixel);
-        MPI_Op_create(over_op, 0, &over);
-        MPI_Reduce_scatter_block(frame, piece, (int)block, pixel, over, ordered);
-        MPI_Gather(piece, (int)block, pixel, frame, (int)block, pixel, root, ordered);
-        MPI_Op_free(&over);
-        MPI_Type_free(&pixel);
-        if (stats)
-            stats->bytes_sent += (block * (size_t)size + (me == root ? 0 : block)) * 16;
-        if (me == root)
-            memcpy(image, frame, pixels * 4 * sizeof *image);
-    } else {
-        size_t total = 0;
-        int mine = (int)((size_t)rect->width * rect->height * 4);
-        if (me == root) {
-            rects = malloc((size_t)size * sizeof *rects);
-            counts = malloc((size_t)size * sizeof *counts);
-            displs = malloc((size_t)size * sizeof *displs);
-        }
-        if (me == root && (!rects || !counts || !displs))
-            st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                            "umbra_mpi_composite: out of memory");
-        st = agree(ordered, ctx, st);
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-        MPI_Gather(rect, (int)sizeof *rect, MPI_BYTE, rects, (int)sizeof *rect, MPI_BYTE, root,
-                   ordered);
-        if (me == root) {
-            for (int i = 0; i < size; ++i) {
-                counts[i] = (int)((size_t)rects[i].width * rects[i].height * 4);
-                displs[i] = (int)total;
-                total += (size_t)counts[i];
-            }
-            if (total > INT_MAX)
-                st = fail(ctx, UMBRA_ERROR_UNSUPPORTED,
-                                                "umbra_mpi_composite: the partial images hold %zu "
-                                                "floats, past MPI's int counts",
-                                                total);
-            else if (!(all = malloc((total ? total : 1) * sizeof *all)))
-                st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                                "umbra_mpi_composite: out of memory");
-        }
-        st = agree(ordered, ctx, st);
-        if (st != UMBRA_SUCCESS)
-            goto fail;
-        MPI_Gatherv(part, mine, MPI_FLOAT, all, counts, displs, MPI_FLOAT, root, ordered);
-        if (stats && me != root)
-            stats->bytes_sent += (uint64_t)mine * sizeof(float);
-        if (me == root) {
-            memset(image, 0, pixels * 4 * sizeof *image);
-            for (int i = 0; i < size; ++i)
-                if (counts[i])
-                    umbra_part_composite(image, width, height, all + displs[i], &rects[i]);
-        }
-    }
-    if (me == root && background)
-        umbra_part_background(image, pixels, background);
-fail:
-    free(all);
-    free(displs);
-    free(counts);
-    free(rects);
-    free(piece);
-    free(frame);
-    if (stats)
-        stats->composite_ms += now_ms() - t0;
-    return st;
-}
-
-/* UMBRA_MPI_COMPOSITE_CHAIN: the frame goes down the ranks in view order, each adding its
- * part's samples to the accumulation of the parts in front (umbra_renderer_render_part_into),
- * then to root, which puts the background under it: one device's image bit for bit. The renders
- * run one after the other (a rank waits for the ones in front of it), as the light chain of
- * umbra_mpi_light does; a rank that fails passes its status on with the frame, and the agreement
- * at the end reports the first failure. */
-static umbra_status render_chain(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
-                                 umbra_volume volume, const umbra_camera *camera, uint32_t width,
-                                 uint32_t height, const float background[4], int root,
-                                 float *image, umbra_mpi_stats *stats)
-{
-    umbra_part_desc part, *all = NULL;
-    umbra_volume_info placement;
-    uint32_t *order = NULL;
-    float *frame = NULL, flag = 0.0f;
-    MPI_Comm ordered = MPI_COMM_NULL;
-    int count = 0, me = 0, pos = 0, size = 1, oroot = -1;
-    const size_t floats = (size_t)width * height * 4;
-    umbra_status st;
-
-    MPI_Comm_rank(comm, &me);
-    MPI_Comm_size(comm, &size);
-    umbra_part_desc_init(&part);
-    st = camera ? umbra_volume_get_part(volume, &part)
-                : fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: camera is NULL");
-    if (st == UMBRA_SUCCESS && (root < 0 || root >= size))
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: root %d of %d ranks",
-                  root, size);
-    if (st == UMBRA_SUCCESS)
-        st = umbra_volume_get_info(volume, &placement);
-    if (st == UMBRA_SUCCESS && (width == 0 || height == 0 || floats > INT_MAX))
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                  "umbra_mpi_render: chain composite of a %u x %u image: it must be non-empty "
-                  "and within MPI's int counts (%zu floats)", width, height, floats);
-    if (st == UMBRA_SUCCESS && me == root && !image)
-        st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra_mpi_render: image is NULL at root");
-    if (st == UMBRA_SUCCESS && !(frame = malloc(floats * sizeof *frame)))
-        st = fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                  "umbra_mpi_render: cannot allocate a %u x %u frame", width, height);
-    st = agree(comm, ctx, st);
-    if (st == UMBRA_SUCCESS)
-        st = gather_parts(comm, ctx, &part, &all, &count);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    order = malloc((size_t)count * sizeof *order);
-    st = order ? umbra_part_view_order(all, (uint32_t)count, &placement, camera, order)
-               : UMBRA_ERROR_OUT_OF_MEMORY;
-    st = agree(comm, ctx, st);
-    if (st == UMBRA_SUCCESS)
-        st = split_in_order(comm, ctx, order, count, &ordered);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    for (int i = 0; i < count; ++i)
-        if (order[i] == (uint32_t)root)
-            oroot = i;
-    MPI_Comm_rank(ordered, &pos);
-    MPI_Comm_size(ordered, &size);
-
-    double t = now_ms();
-    if (pos == 0) {
-        memset(frame, 0, floats * sizeof *frame);
-    } else {
-        MPI_Recv(frame, (int)floats, MPI_FLOAT, pos - 1, 0, ordered, MPI_STATUS_IGNORE);
-        MPI_Recv(&flag, 1, MPI_FLOAT, pos - 1, 1, ordered, MPI_STATUS_IGNORE);
-        if (flag != 0.0f)
-            st = fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                      "umbra_mpi_render: a rank before this one in view order failed");
-    }
-    if (stats)
-        stats->composite_ms += now_ms() - t;
-    t = now_ms();
-    if (st == UMBRA_SUCCESS)
-        st = umbra_renderer_render_part_into(r, width, height, NULL, frame);
-    if (stats)
-        stats->render_ms += now_ms() - t;
-    t = now_ms();
-    flag = st == UMBRA_SUCCESS ? 0.0f : 1.0f;
-    const int next = pos + 1 < size ? pos + 1 : oroot; /* the last rank hands it to root */
-    if (next != pos) {
-        MPI_Send(frame, (int)floats, MPI_FLOAT, next, 0, ordered);
-        MPI_Send(&flag, 1, MPI_FLOAT, next, 1, ordered);
-        if (stats)
-            stats->bytes_sent += floats * sizeof *frame + sizeof flag;
-    }
-    if (pos == oroot && pos != size - 1) {
-        MPI_Recv(frame, (int)floats, MPI_FLOAT, size - 1, 0, ordered, MPI_STATUS_IGNORE);
-        MPI_Recv(&flag, 1, MPI_FLOAT, size - 1, 1, ordered, MPI_STATUS_IGNORE);
-    }
-    if (pos == oroot && st == UMBRA_SUCCESS && flag == 0.0f) {
-        umbra_part_background(frame, (size_t)width * height, background ? background
-                                                                        : (const float[4]){0});
-        memcpy(image, frame, floats * sizeof *image);
-    }
-    if (stats)
-        stats->composite_ms += now_ms() - t;
-    st = agree(comm, ctx, st);
-fail:
-    if (ordered != MPI_COMM_NULL)
-        MPI_Comm_free(&ordered);
-    free(order);
-    free(all);
-    free(frame);
-    return st;
-}
-
-umbra_status umbra_mpi_render(MPI_Comm comm, umbra_context ctx, umbra_renderer r,
-                              umbra_volume volume, const umbra_camera *camera, uint32_t width,
-                              uint32_t height, const float background[4],
-                              umbra_mpi_composite_mode mode, int root, float *image,
-                              umbra_mpi_stats *stats)
-{
-    if (mode == UMBRA_MPI_COMPOSITE_CHAIN)
-        return render_chain(comm, ctx, r, volume, camera, width, height, background, root, image,
-                            stats);
-    umbra_part_rect rect = {0, 0, 0, 0};
-    umbra_part_desc part, *all = NULL;
-    umbra_volume_info placement;
-    uint32_t *order = NULL;
-    float *pixels = NULL;
-    MPI_Comm ordered = MPI_COMM_NULL;
-    int count = 0, me = 0, oroot = 0;
-    double t = now_ms();
-    umbra_status st;
-
-    umbra_part_desc_init(&part);
-    st = camera ? umbra_volume_get_part(volume, &part)
-                : fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                             "umbra_mpi_render: camera is NULL");
-    if (st == UMBRA_SUCCESS)
-        st = umbra_volume_get_info(volume, &placement);
-    if (st == UMBRA_SUCCESS)
-        st = umbra_renderer_part_rect(r, width, height, &rect);
-    if (st == UMBRA_SUCCESS) {
-        pixels = malloc(((size_t)rect.width * rect.height * 4 + 1) * sizeof *pixels);
-        st = pixels ? umbra_renderer_render_part(r, width, height, &rect, pixels)
-                    : fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY,
-                                                 "umbra_mpi_render: out of memory");
-    }
-    st = agree(comm, ctx, st);
-    if (stats)
-        stats->render_ms += now_ms() - t;
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    st = gather_parts(comm, ctx, &part, &all, &count);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    order = malloc((size_t)count * sizeof *order);
-    st = order ? umbra_part_view_order(all, (uint32_t)count, &placement, camera, order)
-               : UMBRA_ERROR_OUT_OF_MEMORY;
-    st = agree(comm, ctx, st);
-    if (st == UMBRA_SUCCESS)
-        st = split_in_order(comm, ctx, order, count, &ordered);
-    if (st != UMBRA_SUCCESS)
-        goto fail;
-    /* root, a rank of comm, in the view-ordered communicator (-1: none, refused there). */
-    MPI_Comm_rank(comm, &me);
-    oroot = -1;
-    for (int i = 0; i < count; ++i)
-        if (order[i] == (uint32_t)root)
-            oroot = i;
-    st = umbra_mpi_composite(ordered, ctx, pixels, &rect, width, height, background, mode, oroot,
-                             me == root ? image : NULL, stats);
-fail:
-    if (ordered != MPI_COMM_NULL)
-        MPI_Comm_free(&ordered);
-    free(order);
-    free(all);
-    free(pixels);
     return st;
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/techniques/deep.h: the deep shadow map technique (host/techniques/deep.c,
- * kernels/techniques/deep.cl)
- * and the internals its tests look at: the block layout, the pool and the lookup-table cache. */
+ * kernels/techniques/deep.cl), its pieces on parts (host/techniques/deep_part.c) and the
+ * internals its tests look at: the block layout, the pool and the lookup-table cache. */
 #ifndef UMBRA_SHADOW_DEEP_H
 #define UMBRA_SHADOW_DEEP_H
 
@@ -55,11 +55,12 @@ umbra_status umbra__deep_set_limit(umbra_renderer r, size_t blocks);
 umbra_status umbra__deep_read(umbra_renderer r, int32_t *head, int32_t *next, uint32_t *counts,
                               float *nodes);
 
-/* A part's pieces of the unbounded map (host/part_render.c): the export writes the built map's
- * node count per texel (map_size^2) and, unless nodes is NULL, its nodes in texel order (1 +
- * channels floats each; *node_count their capacity in, their number out); the import merges
- * the pieces of `parts` parts (counts: parts x map_size^2, part-major; nodes: their arrays one
- * after another, node_count in all) per texel in depth order into the map, in blocks. */
+/* A part's pieces of the unbounded map (host/techniques/deep_part.c, for host/part_render.c):
+ * the export writes the built map's node count per texel (map_size^2) and, unless nodes is
+ * NULL, its nodes in texel order (1 + channels floats each; *node_count their capacity in, their
+ * number out); the import merges the pieces of `parts` parts (counts: parts x map_size^2,
+ * part-major; nodes: their arrays one after another, node_count in all) per texel in depth
+ * order into the map, in blocks. */
 umbra_status umbra__deep_part_export(umbra_renderer r, uint32_t *counts, float *nodes,
                                      size_t *node_count);
 umbra_status umbra__deep_part_import(umbra_renderer r, uint32_t parts, const uint32_t *counts,

@@ -307,17 +307,18 @@ UMBRA_INLINE void volume_cell(VOLUME_PARAM, VolGeom g, int3 i0, float *c)
 /* The view ray's classification in one step (issue #28): sample_stored's value s maps to a
  * transfer function table's coordinate by one multiply-add, s * a + b (TfMap), clamped once to
  * the table, instead of voxel_normalise's map and clamp followed by tf_lookup's clamp and scale.
- * The same line as tf_lookup(sample_volume(..)) where nothing clamps, up to float rounding. */
+ * The view table carries one entry past its last, a copy of it (host/tables.c, corrected_table),
+ * so that the interval's first entry is the coordinate's integer part, with no clamp to n - 2:
+ * at the top, x = n - 1, the blend is the last entry with weight 0 on the copy. The same line as
+ * tf_lookup(sample_volume(..)) where nothing clamps, up to float rounding. */
 typedef struct TfMap {
     float a, b, top; /* table coordinate s * a + b, clamped to [0, top = n - 1] */
-    int last;        /* n - 2: the last interval's first entry */
 } TfMap;
 
 inline TfMap tf_map(VolGeom g, uint n)
 {
     TfMap m;
     m.top = (float)(n - 1);
-    m.last = (int)n - 2;
 #if !UMBRA_SAMPLER_IMAGE && UMBRA_VOXEL_CLAMPS
     m.a = m.top; /* sample_stored is normalised already */
     m.b = 0.0f;
@@ -328,11 +329,12 @@ inline TfMap tf_map(VolGeom g, uint n)
     return m;
 }
 
-/* tf's entry at sample_stored value s, linearly interpolated (tf_lookup's arithmetic). */
+/* tf's entry at sample_stored value s, linearly interpolated; tf holds n + 1 entries, the last
+ * two equal (TfMap). */
 UMBRA_INLINE float4 tf_classify(__global const float4 *tf, TfMap m, float s)
 {
     float x = clamp(fma(s, m.a, m.b), 0.0f, m.top);
-    int i = min((int)x, m.last);
+    int i = (int)x;
     float f = x - (float)i;
     return mix(tf[i], tf[i + 1], f);
 }
@@ -429,7 +431,7 @@ UMBRA_INLINE float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * loaded as stored (uchar, ushort or short without UMBRA_VOXEL_CLAMPS) spanning at most 32767
  * (the host builds the volume only there), so gradient_volume_sample blends the same floats in
  * the same order: the same gradient bit for bit. 8 bytes a voxel, built only for shaded frames
- * and again when the volume changes (host/renderer.c, gradient_volume). Whole volumes in one
+ * and again when the volume changes (host/gradient_volume.c). Whole volumes in one
  * buffer only (UMBRA_GRADIENT_VOLUME). */
 #if !UMBRA_PART && !UMBRA_VOXEL_CLAMPS
 #define UMBRA_GRADIENT_VOLUME 1

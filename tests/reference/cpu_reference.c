@@ -86,9 +86,22 @@ static void lookup(const float *tf, int n, float v, float out[4])
         out[c] = lerp(tf[4 * i + c], tf[4 * i + 4 + c], f);
 }
 
+/* lookup in a table of n + 1 entries whose last two are equal (corrected's view table; the
+ * kernels' tf_classify): the interval's first entry is x's integer part, with no clamp. */
+static void view_lookup(const float *tf, int n, float v, float out[4])
+{
+    float x = clampf(v, 0.0f, 1.0f) * (float)(n - 1);
+    int i = (int)x;
+    float f = x - (float)i;
+    for (int c = 0; c < 4; ++c)
+        out[c] = lerp(tf[4 * i + c], tf[4 * i + 4 + c], f);
+}
+
+/* tf with alpha corrected for the step (as given for step 0), followed by a copy of its last
+ * entry (view_lookup). */
 static float *corrected(const float *tf, int n, float step_voxels)
 {
-    float *t = malloc((size_t)n * 4 * sizeof *t);
+    float *t = malloc((size_t)(n + 1) * 4 * sizeof *t);
     if (!t)
         return NULL;
     for (int i = 0; i < n; ++i) {
@@ -98,6 +111,7 @@ static float *corrected(const float *tf, int n, float step_voxels)
                        : a < 1.0 ? (float)-expm1((double)step_voxels * log1p(-a))
                                  : 1.0f;
     }
+    memcpy(t + 4 * n, t + 4 * (n - 1), 4 * sizeof *t);
     return t;
 }
 
@@ -987,7 +1001,7 @@ static uint32_t pixel(const prep *P, const view *V, uint32_t w, uint32_t h, int 
                 }
                 v3 p = add(org, mul(d, t));
                 ++taken;
-                lookup(P->view_tf, P->view_n, sample_voxel(P, add(xo, mul(xd, t))), c);
+                view_lookup(P->view_tf, P->view_n, sample_voxel(P, add(xo, mul(xd, t))), c);
                 if (c[3] > 0.0f) {
                     /* The light at p + h (m - (1 + a)/2) along d, m the mean emission depth of
                      * a segment of opacity a (kernels/raycast.cl, shadow_point). */
