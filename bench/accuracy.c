@@ -133,7 +133,6 @@ float accuracy_exact_step(const scene_spec *s)
     return s->reference_step > 0.0f ? s->reference_step : 0.25f;
 }
 
-static int in_list(const char *list, const char *name);
 
 /* The sweep for one scene, less the techniques --techniques leaves out (the exact reference and
  * the unshadowed frame always stay: every other row is measured against them). */
@@ -146,7 +145,7 @@ void accuracy_scene_configs(const options *o, const scene_spec *s, config_list *
     for (int i = 0; i < L->count; ++i) {
         const config *c = &L->items[i];
         if (c->exact || c->desc.technique == UMBRA_SHADOW_NONE ||
-            in_list(o->techniques, umbra_shadow_technique_name(c->desc.technique)))
+            bench_in_list(o->techniques, umbra_shadow_technique_name(c->desc.technique)))
             L->items[n++] = *c;
     }
     L->count = n;
@@ -389,21 +388,6 @@ static int cmp_str(const void *a, const void *b)
     return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
-static int in_list(const char *list, const char *name)
-{
-    size_t n = strlen(name);
-    for (const char *p = list; *p;) {
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
-        if (len == n && strncmp(p, name, n) == 0)
-            return 1;
-        if (!comma)
-            break;
-        p = comma + 1;
-    }
-    return 0;
-}
-
 /* Reads the scene files: all of the scene directory (sorted by name), or those --scenes names.
  * A malformed file stops the bench with its message. */
 static int load_scenes(bench_run *B)
@@ -441,8 +425,8 @@ static int load_scenes(bench_run *B)
     for (int i = 0; i < n; ++i) {
         char path[SCENE_PATH_MAX + 512], err[1024], stem[SCENE_NAME_MAX];
         snprintf(stem, sizeof stem, "%.*s", (int)(strlen(names[i]) - 6), names[i]);
-        const int from_merge = in_list(merged, stem);
-        if (B->o.scenes[0] && !in_list(B->o.scenes, stem) && !from_merge)
+        const int from_merge = bench_in_list(merged, stem);
+        if (B->o.scenes[0] && !bench_in_list(B->o.scenes, stem) && !from_merge)
             continue;
         snprintf(path, sizeof path, "%s/%s", B->o.scene_dir, names[i]);
         scene_spec *s = &B->scenes[B->scene_count];
@@ -452,7 +436,7 @@ static int load_scenes(bench_run *B)
             break;
         }
         const int selected = B->o.report      ? 0
-                             : B->o.scenes[0] ? in_list(B->o.scenes, stem)
+                             : B->o.scenes[0] ? bench_in_list(B->o.scenes, stem)
                                               : !(B->o.quick && !s->quick);
         if (!selected && !from_merge)
             continue;

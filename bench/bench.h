@@ -103,6 +103,9 @@ void bench_results_header(FILE *f, const char *subcommand, int argc, char **argv
 
 /* ---- command-line helpers ---------------------------------------------------------------------------- */
 
+/* Whether name is one of the names of a comma-separated list. */
+int bench_in_list(const char *list, const char *name);
+
 /* Strict parsers: the whole string must be a number in range; return 0 on success. */
 int bench_parse_int(const char *s, long lo, long hi, long *out);
 int bench_parse_float(const char *s, float lo, float hi, float *out);

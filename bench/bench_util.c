@@ -63,6 +63,21 @@ void bench_csv_row(FILE *f, const char *name, bench_timing t, uint64_t samples)
 
 /* The bench's one whole-number check: an optional '-' then decimal digits only (strtol alone
  * takes blanks, '+' and wraps nothing but says little), the value in [lo, hi]. */
+int bench_in_list(const char *list, const char *name)
+{
+    const size_t n = strlen(name);
+    for (const char *p = list; *p;) {
+        const char *comma = strchr(p, ',');
+        const size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0)
+            return 1;
+        if (!comma)
+            break;
+        p = comma + 1;
+    }
+    return 0;
+}
+
 int bench_parse_int(const char *s, long lo, long hi, long *out)
 {
     char *end;

@@ -62,8 +62,9 @@ static variant variants[MAX_VARIANTS];
 static int variant_count;
 
 /* The variants from the registry, in its order: each build setting of each light-space map,
- * grey, and coloured too for a technique that carries colour. */
-static void make_variants(void)
+ * grey, and coloured too for a technique that carries colour; of them only those named in only
+ * (NULL: all) beside the first two, the ratios' bases. */
+static void make_variants(const char *only)
 {
     variant_count = 0;
     for (uint32_t t = 0; t < umbra_technique_count(); ++t) {
@@ -82,6 +83,8 @@ static void make_variants(void)
                 v->technique = tech->info.id;
                 v->params = tech->sweep[i].params;
                 v->transmission = colored ? UMBRA_TRANSMISSION_COLORED : UMBRA_TRANSMISSION_GREY;
+                if (variant_count > MATCHED + 1 && only && !bench_in_list(only, v->name))
+                    --variant_count;
             }
         }
     }
@@ -91,7 +94,7 @@ typedef struct options {
     char scenes[256], scene_dir[1024];
     uint32_t sizes[MAX_SIZES];
     int nsizes, builds, warmup;
-    const char *results, *device;
+    const char *results, *device, *variants;
 } options;
 
 typedef struct row {
@@ -113,6 +116,8 @@ static void usage(FILE *f)
             "  --sizes A,B      map sizes (default 512,1024; each 16..8192)\n"
             "  --scenes A,B     scene files' stems (default walnut,bonsai)\n"
             "  --scene-dir DIR  scene files (default <source>/bench/scenes)\n"
+            "  --variants A,B   only these variants (names as in the table) beside threshold\n"
+            "                   and threshold-0.99, the ratios' bases (default: all)\n"
             "  --results DIR    also write DIR/builds.csv and DIR/builds.md\n"
             "  --device SPEC    OpenCL device (P:D or a name substring)\n");
 }
@@ -156,6 +161,8 @@ static int parse_options(int argc, char **argv, options *o)
             snprintf(o->scenes, sizeof o->scenes, "%s", v);
         } else if (strcmp(a, "--scene-dir") == 0 && v) {
             snprintf(o->scene_dir, sizeof o->scene_dir, "%s", v);
+        } else if (strcmp(a, "--variants") == 0 && v) {
+            o->variants = v;
         } else if (strcmp(a, "--results") == 0 && v) {
             o->results = v;
         } else if (strcmp(a, "--device") == 0 && v) {
@@ -355,7 +362,7 @@ int bench_builds(int argc, char **argv)
     int rc = parse_options(argc, argv, &o);
     if (rc != 0)
         return rc > 0 ? 0 : 2;
-    make_variants();
+    make_variants(o.variants);
     umbra_context ctx = bench_context(o.device);
     if (!ctx)
         return 1;

@@ -333,15 +333,6 @@ static umbra_status run_sequence(session *S, const options *o, sequence seq, row
     return st;
 }
 
-static int in_list(const char *list, const char *name)
-{
-    size_t n = strlen(name);
-    for (const char *p = list; (p = strstr(p, name)) != NULL; p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
-            return 1;
-    return 0;
-}
-
 /* All sequences of one scene file, shading on and off, appended to rows. */
 static int run_scene(umbra_context ctx, const options *o, const char *name, row *rows, int *nrows)
 {
@@ -386,12 +377,12 @@ static int run_scene(umbra_context ctx, const options *o, const char *name, row 
     for (int shading = 1; shading >= 0 && st == UMBRA_SUCCESS; --shading) {
         S.scene.options.shading = shading;
         for (int t = 0; t < ntechs && st == UMBRA_SUCCESS; ++t) {
-            if (!in_list(o->techniques, umbra_shadow_technique_name(techs[t])))
+            if (!bench_in_list(o->techniques, umbra_shadow_technique_name(techs[t])))
                 continue;
             if ((st = renderer_for(&S, techs[t], o->map_size, &S.shadowed)) == UMBRA_SUCCESS)
                 st = renderer_for(&S, UMBRA_SHADOW_NONE, 0, &S.none);
             for (int q = 0; q < SEQ_COUNT && st == UMBRA_SUCCESS && *nrows < MAX_ROWS; ++q) {
-                if (!in_list(o->sequences, sequence_names[q]))
+                if (!bench_in_list(o->sequences, sequence_names[q]))
                     continue;
                 if (q == SEQ_LIGHT_AUTO) {
                     /* The last sequence: progressive shadows on for it. */

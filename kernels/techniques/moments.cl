@@ -167,6 +167,78 @@ UMBRA_INLINE void mom_mix(float rad, int count, const float *pw, float *sum)
     }
 }
 
+/* The march of one texel's light ray (o, d over tb), into tau, pw and sum (zeroed by the
+ * caller). count is a constant at each call (moments_build's switch), so that the loops over the
+ * moments and channels unroll and the sums stay in registers: with count read at run time they
+ * live in memory, loaded and stored per segment and channel. */
+UMBRA_INLINE void mom_march(__global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
+                            __global const float4 *light_tf, __global const ulong *light_cells,
+                            __global const UmbraShadow *S, const float cap, float3 o, float3 d,
+                            float2 tb, float x_of0, float x_per_t, const int count,
+                            float tau[UMBRA_LIGHT_CHANNELS],
+                            float pw[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1],
+                            float sum[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1])
+{
+    const float h = S->step;
+    const float h_vox = light_step_voxels(F, S);
+    const uint n_tf = F->light_tf_size, flags = F->flags;
+    const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
+    const float len = tb.y - tb.x;
+    const int n_full = (int)floor(len / h);
+    const float last = len - (float)n_full * h;
+    CellWalk w = walk_begin(g, o, d, tb.x);
+    float t_cell = -UMBRA_INF;
+    for (int k = 0; k <= n_full;) {
+        if (skip && k < n_full && tb.x + ((float)k + 0.5f) * h >= t_cell)
+            k = walk_next_sample(&w, g, light_cells, tb.x, h, 0.5f, k, n_full, tb.y, &t_cell);
+        const float seg = k < n_full ? h : last;
+        if (!(seg > 0.0f))
+            break;
+        const float t_start = tb.x + (float)k * h;
+        const float t_mid = t_start + 0.5f * seg;
+        const float4 col = light_sample(F, vol, g, light_tf, n_tf, o + t_mid * d);
+        if (col.w > 0.0f) {
+            const light_t od = light_depth(col, h_vox * (seg / h), flags);
+            const float mid = x_of0 + t_mid * x_per_t, rad = 0.5f * seg * x_per_t;
+            float mp[UMBRA_MOMENTS_MAX + 1];
+            mp[0] = 1.0f;
+            for (int i = 1; i <= count; ++i)
+                mp[i] = mp[i - 1] * mid;
+            int going = 0;
+            for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
+                const float odc = MOM_CH(od, c);
+                if (tau[c] >= cap)
+                    continue;
+                if (tau[c] + odc < cap) {
+                    tau[c] += odc;
+                    if (k < n_full) {
+                        for (int i = 0; i <= count; ++i)
+                            pw[c][i] += odc * mp[i];
+                    } else { /* the partial last segment */
+                        float e[UMBRA_MOMENTS_MAX + 1];
+                        mom_segment(mid, rad, count, e);
+                        for (int i = 1; i <= count; ++i)
+                            sum[c][i] += odc * e[i];
+                    }
+                    ++going;
+                    continue;
+                }
+                /* The cap is passed in this segment: only its part in front of that point, at
+                 * the segment's density. */
+                const float part = cap - tau[c], f = part / odc;
+                float ec[UMBRA_MOMENTS_MAX + 1];
+                mom_segment(mid - rad + f * rad, f * rad, count, ec);
+                for (int i = 1; i <= count; ++i)
+                    sum[c][i] += part * ec[i];
+                tau[c] = cap;
+            }
+            if (!going)
+                break;
+        }
+        ++k;
+    }
+}
+
 __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
                             __global const float4 *view_tf, __global const float4 *light_tf,
                             __global const uchar *view_bricks, __global const ulong *light_cells,
@@ -180,7 +252,6 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
     (void)view_tf;
     (void)view_bricks;
     const int count = (int)P->count;
-    const float cap = P->depth_cap;
     /* tau: the optical depth so far; pw: the whole segments' sums of od mid^j; sum: the
      * partial segments' sums of od e[k] */
     float tau[UMBRA_LIGHT_CHANNELS], pw[UMBRA_LIGHT_CHANNELS][UMBRA_MOMENTS_MAX + 1],
@@ -196,66 +267,18 @@ __kernel void moments_build(__global const UmbraFrame *F, VOLUME_PARAM,
     /* the warped depth is affine in the ray parameter: x(t) = x_of0 + t x_per_t */
     const float x_of0 = 2.0f * ls_depth(S, o, 0.0f) - 1.0f;
     const float x_per_t = 2.0f * S->near_far[2];
-    const float h = S->step;
-    const float rad_full = 0.5f * h * x_per_t;
+    const float rad_full = 0.5f * S->step * x_per_t;
     if (tb.y > tb.x) {
-        const float h_vox = light_step_voxels(F, S);
-        const uint n_tf = F->light_tf_size, flags = F->flags;
-        const int skip = (flags & UMBRA_FLAG_SKIP_EMPTY) != 0;
-        const float len = tb.y - tb.x;
-        const int n_full = (int)floor(len / h);
-        const float last = len - (float)n_full * h;
-        CellWalk w = walk_begin(g, o, d, tb.x);
-        float t_cell = -UMBRA_INF;
-        for (int k = 0; k <= n_full;) {
-            if (skip && k < n_full && tb.x + ((float)k + 0.5f) * h >= t_cell)
-                k = walk_next_sample(&w, g, light_cells, tb.x, h, 0.5f, k, n_full, tb.y, &t_cell);
-            const float seg = k < n_full ? h : last;
-            if (!(seg > 0.0f))
-                break;
-            const float t_start = tb.x + (float)k * h;
-            const float t_mid = t_start + 0.5f * seg;
-            const float4 col = light_sample(F, vol, g, light_tf, n_tf, o + t_mid * d);
-            if (col.w > 0.0f) {
-                const light_t od = light_depth(col, h_vox * (seg / h), flags);
-                const float mid = x_of0 + t_mid * x_per_t, rad = 0.5f * seg * x_per_t;
-                float mp[UMBRA_MOMENTS_MAX + 1];
-                mp[0] = 1.0f;
-                for (int i = 1; i <= count; ++i)
-                    mp[i] = mp[i - 1] * mid;
-                int going = 0;
-                for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
-                    const float odc = MOM_CH(od, c);
-                    if (tau[c] >= cap)
-                        continue;
-                    if (tau[c] + odc < cap) {
-                        tau[c] += odc;
-                        if (k < n_full) {
-                            for (int i = 0; i <= count; ++i)
-                                pw[c][i] += odc * mp[i];
-                        } else { /* the partial last segment */
-                            float e[UMBRA_MOMENTS_MAX + 1];
-                            mom_segment(mid, rad, count, e);
-                            for (int i = 1; i <= count; ++i)
-                                sum[c][i] += odc * e[i];
-                        }
-                        ++going;
-                        continue;
-                    }
-                    /* The cap is passed in this segment: only its part in front of that point,
-                     * at the segment's density. */
-                    const float part = cap - tau[c], f = part / odc;
-                    float ec[UMBRA_MOMENTS_MAX + 1];
-                    mom_segment(mid - rad + f * rad, f * rad, count, ec);
-                    for (int i = 1; i <= count; ++i)
-                        sum[c][i] += part * ec[i];
-                    tau[c] = cap;
-                }
-                if (!going)
-                    break;
-            }
-            ++k;
-        }
+        const float cap = P->depth_cap;
+        if (count == 4)
+            mom_march(F, vol, g, light_tf, light_cells, S, cap, o, d, tb, x_of0, x_per_t, 4, tau,
+                      pw, sum);
+        else if (count == 6)
+            mom_march(F, vol, g, light_tf, light_cells, S, cap, o, d, tb, x_of0, x_per_t, 6, tau,
+                      pw, sum);
+        else
+            mom_march(F, vol, g, light_tf, light_cells, S, cap, o, d, tb, x_of0, x_per_t, 8, tau,
+                      pw, sum);
     }
     const size_t texel = ((size_t)y * (size_t)n + (size_t)x) * UMBRA_LIGHT_CHANNELS;
     for (int c = 0; c < UMBRA_LIGHT_CHANNELS; ++c) {
