@@ -188,6 +188,41 @@ umbra_volume part_volume(umbra_context ctx, const float *voxels, const umbra_par
     return v;
 }
 
+/* A part volume and a renderer with the shadow sd for each of the n parts; *info gets the
+ * volumes' info (the global grid's, the same for every part). */
+void part_renderers(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
+                    const scene *s, const umbra_shadow_desc *sd, const umbra_part_desc *parts,
+                    uint32_t n, umbra_volume *vols, umbra_renderer *rs, umbra_volume_info *info)
+{
+    for (uint32_t i = 0; i < n; ++i) {
+        vols[i] = part_volume(ctx, voxels, &parts[i]);
+        assert_int_equal(umbra_volume_get_info(vols[i], info), UMBRA_SUCCESS);
+        rs[i] = scene_renderer(ctx, vols[i], tf, s);
+        assert_int_equal(umbra_renderer_set_shadow(rs[i], sd), UMBRA_SUCCESS);
+    }
+}
+
+/* The light's march state passed through the parts in light order
+ * (umbra_part_visibility_order): each part imports what the part before it exported (nothing
+ * for the first) and exports its own into state (the light info's tau_floats floats). */
+void pass_light(const scene *s, const umbra_part_desc *parts, uint32_t n,
+                const umbra_volume_info *info, umbra_renderer *rs, float *state)
+{
+    uint32_t order[16];
+    assert_true(n <= 16);
+    const int point = s->light.type == UMBRA_LIGHT_POINT;
+    assert_int_equal(umbra_part_visibility_order(parts, n, info,
+                                                 point ? s->light.position : s->light.direction,
+                                                 point, order),
+                     UMBRA_SUCCESS);
+    for (uint32_t i = 0; i < n; ++i) {
+        umbra_renderer r = rs[order[i]];
+        assert_int_equal(umbra_renderer_part_import_transmittance(r, i ? state : NULL),
+                         UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_export_transmittance(r, state), UMBRA_SUCCESS);
+    }
+}
+
 /* Counts the floats of a and b whose bits differ. */
 size_t bits_differing(const float *a, const float *b, size_t count)
 {

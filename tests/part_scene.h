@@ -54,6 +54,18 @@ uint32_t make_parts(const uint32_t *const cuts[3], const uint32_t ncuts[3], int 
  * empty part), with the scene's volume description. */
 umbra_volume part_volume(umbra_context ctx, const float *voxels, const umbra_part_desc *p);
 
+/* A part volume and a renderer with the shadow sd for each of the n parts; *info gets the
+ * volumes' info (the global grid's, the same for every part). */
+void part_renderers(umbra_context ctx, const float *voxels, umbra_transfer_function tf,
+                    const scene *s, const umbra_shadow_desc *sd, const umbra_part_desc *parts,
+                    uint32_t n, umbra_volume *vols, umbra_renderer *rs, umbra_volume_info *info);
+
+/* The light's march state passed through the parts in light order
+ * (umbra_part_visibility_order): each part imports what the part before it exported (nothing
+ * for the first) and exports its own into state (the light info's tau_floats floats). */
+void pass_light(const scene *s, const umbra_part_desc *parts, uint32_t n,
+                const umbra_volume_info *info, umbra_renderer *rs, float *state);
+
 /* Counts the floats of a and b whose bits differ. */
 size_t bits_differing(const float *a, const float *b, size_t count);
 

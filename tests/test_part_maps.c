@@ -61,12 +61,7 @@ static float compare_map(umbra_context ctx, const float *voxels, umbra_transfer_
     umbra_volume vols[16];
     umbra_renderer rs[16];
     umbra_volume_info info;
-    for (uint32_t i = 0; i < n; ++i) {
-        vols[i] = part_volume(ctx, voxels, &parts[i]);
-        assert_int_equal(umbra_volume_get_info(vols[i], &info), UMBRA_SUCCESS);
-        rs[i] = scene_renderer(ctx, vols[i], tf, s);
-        assert_int_equal(umbra_renderer_set_shadow(rs[i], &sd), UMBRA_SUCCESS);
-    }
+    part_renderers(ctx, voxels, tf, s, &sd, parts, n, vols, rs, &info);
     umbra_part_light_info li = {.struct_size = sizeof li};
     assert_int_equal(umbra_renderer_part_light_info(rs[0], &li), UMBRA_SUCCESS);
     assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU_DEPTH);
@@ -79,17 +74,7 @@ static float compare_map(umbra_context ctx, const float *voxels, umbra_transfer_
     float *acc = malloc(li.depth_floats * sizeof *acc);
     uint32_t order[16];
     assert_true(state && depth && acc);
-    const int point = s->light.type == UMBRA_LIGHT_POINT;
-    assert_int_equal(umbra_part_visibility_order(parts, n, &info,
-                                                 point ? s->light.position : s->light.direction,
-                                                 point, order),
-                     UMBRA_SUCCESS);
-    for (uint32_t i = 0; i < n; ++i) {
-        umbra_renderer r = rs[order[i]];
-        assert_int_equal(umbra_renderer_part_import_transmittance(r, i ? state : NULL),
-                         UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_part_export_transmittance(r, state), UMBRA_SUCCESS);
-    }
+    pass_light(s, parts, n, &info, rs, state);
     for (size_t t = 0; t < li.depth_floats; ++t)
         acc[t] = INFINITY;
     for (uint32_t i = 0; i < n; ++i) {
@@ -216,12 +201,7 @@ static deep_result compare_deep(umbra_context ctx, const float *voxels, umbra_tr
     umbra_volume vols[16];
     umbra_renderer rs[16];
     umbra_volume_info info;
-    for (uint32_t i = 0; i < n; ++i) {
-        vols[i] = part_volume(ctx, voxels, &parts[i]);
-        assert_int_equal(umbra_volume_get_info(vols[i], &info), UMBRA_SUCCESS);
-        rs[i] = scene_renderer(ctx, vols[i], tf, s);
-        assert_int_equal(umbra_renderer_set_shadow(rs[i], &sd), UMBRA_SUCCESS);
-    }
+    part_renderers(ctx, voxels, tf, s, &sd, parts, n, vols, rs, &info);
     umbra_part_light_info li = {.struct_size = sizeof li};
     assert_int_equal(umbra_renderer_part_light_info(rs[0], &li), UMBRA_SUCCESS);
     assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU);
@@ -232,17 +212,7 @@ static deep_result compare_deep(umbra_context ctx, const float *voxels, umbra_tr
     uint32_t *counts = malloc(n * texels * sizeof *counts);
     uint32_t order[16];
     assert_true(state && counts);
-    const int point = s->light.type == UMBRA_LIGHT_POINT;
-    assert_int_equal(umbra_part_visibility_order(parts, n, &info,
-                                                 point ? s->light.position : s->light.direction,
-                                                 point, order),
-                     UMBRA_SUCCESS);
-    for (uint32_t i = 0; i < n; ++i) {
-        umbra_renderer r = rs[order[i]];
-        assert_int_equal(umbra_renderer_part_import_transmittance(r, i ? state : NULL),
-                         UMBRA_SUCCESS);
-        assert_int_equal(umbra_renderer_part_export_transmittance(r, state), UMBRA_SUCCESS);
-    }
+    pass_light(s, parts, n, &info, rs, state);
     /* The pieces: counts first, then the nodes, one part after another. */
     size_t total = 0, at[17];
     for (uint32_t i = 0; i < n; ++i) {
