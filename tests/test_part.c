@@ -391,6 +391,17 @@ static void test_bad_input_refused(void **state)
         umbra_part_light_info li = {.struct_size = sizeof li};
         assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
         assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU);
+        /* Its state is a visibility per light channel: one above 1 is refused naming the texel
+         * (the table in host/part_render.c, shared with threshold and CSSM). */
+        float *vis = malloc(li.tau_floats * sizeof *vis);
+        assert_non_null(vis);
+        for (size_t i = 0; i < li.tau_floats; ++i)
+            vis[i] = 1.0f;
+        vis[3] = 1.5f;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, vis),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 3 (3, 0): visibility 1.5",
+                           "[0, 1]");
+        free(vis);
         const size_t texels = (size_t)li.map_size * li.map_size, nf = 1 + li.channels;
         uint32_t *counts = malloc(texels * sizeof *counts);
         size_t k = 0;
