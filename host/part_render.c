@@ -8,6 +8,7 @@
  * (kernels/raycast.cl, part_owns) and addresses the carried voxels (kernels/common/sampling.cl,
  * PART_INDEX). */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -245,32 +246,60 @@ umbra_status umbra_renderer_part_rect(umbra_renderer r, uint32_t width, uint32_t
 
 /* A technique whose parts march the light (threshold, CSSM, deep): the state one part hands the
  * next on a texel's light ray, and what the parts share once all have marched.
- *  - state: floats per texel, or 0 for one per light channel (r->channels, set by
- *    umbra__frame_update_light); per float (one slot for every channel when per channel) its
- *    value for a part first on the ray, the range an import must lie in and its name;
+ *  - state: per texel a run of fields, each one float or one per light channel (r->channels,
+ *    set by umbra__frame_update_light); per field its value for a part first on the ray, the
+ *    range an import must lie in, whether it counts (an integer) and its name;
  *  - shares: a depth per texel or per channel, which the parts reduce with umbra_part_minimum,
  *    or the pieces of the deep map, merged per texel (umbra_renderer_part_export_deep). */
 typedef enum { SHARES_DEPTH, SHARES_DEPTH_PER_CHANNEL, SHARES_PIECES } PartShares;
 
+typedef struct PartField {
+    const char *name;
+    int per_channel, integral;
+    float start, lo, hi;
+} PartField;
+
 typedef struct PartLight {
     umbra_shadow_technique technique;
-    uint32_t state;
-    float start[2], lo[2], hi[2];
-    const char *name[2];
+    const PartField *fields;
+    uint32_t field_count;
     PartShares shares;
 } PartLight;
 
-static const PartLight PART_LIGHTS[] = {
-    /* kernels/techniques/threshold.cl: the product P of whole segments' 1 - alpha and the
-     * optical depth tau. */
-    {UMBRA_SHADOW_THRESHOLD, 2, {1.0f, 0.0f}, {0.0f, 0.0f}, {1.0f, INFINITY},
-     {"transmittance product", "optical depth"}, SHARES_DEPTH},
-    /* kernels/techniques/cssm.cl: the optical depth of each channel's photon. */
-    {UMBRA_SHADOW_CSSM, 0, {0.0f}, {0.0f}, {INFINITY}, {"optical depth"},
-     SHARES_DEPTH_PER_CHANNEL},
-    /* kernels/techniques/deep.cl (part_state): the visibility per channel. */
-    {UMBRA_SHADOW_DEEP, 0, {1.0f}, {0.0f}, {1.0f}, {"visibility"}, SHARES_PIECES},
+/* kernels/techniques/threshold.cl: the product P of whole segments' 1 - alpha and the optical
+ * depth tau. */
+static const PartField THRESHOLD_STATE[] = {
+    {"transmittance product", 0, 0, 1.0f, 0.0f, 1.0f},
+    {"optical depth", 0, 0, 0.0f, 0.0f, INFINITY},
 };
+/* kernels/techniques/cssm.cl: the optical depth of each channel's photon. */
+static const PartField CSSM_STATE[] = {{"optical depth", 1, 0, 0.0f, 0.0f, INFINITY}};
+/* kernels/techniques/deep.cl (deep_state_load): the march's visibility and its fit's state, in
+ * the order of kernels/techniques/deep_shared.h (DEEP_PART_STATE_FLOATS), starting as
+ * deep_texel_init and deep_fit_init start a ray. */
+static const PartField DEEP_STATE[] = {
+    {"visibility", 1, 0, 1.0f, 0.0f, 1.0f},
+    {"fit origin depth", 0, 0, 0.0f, -INFINITY, INFINITY},
+    {"fit origin visibility", 1, 0, 1.0f, 0.0f, 1.0f},
+    {"last point's depth", 0, 0, 0.0f, -INFINITY, INFINITY},
+    {"last point's visibility", 1, 0, 1.0f, 0.0f, 1.0f},
+    {"held point's depth", 0, 0, 0.0f, -INFINITY, INFINITY},
+    {"held point's visibility", 1, 0, 1.0f, 0.0f, 1.0f},
+    {"lowest slope", 1, 0, 0.0f, -INFINITY, INFINITY},
+    {"highest slope", 1, 0, 0.0f, -INFINITY, INFINITY},
+    {"points since the origin", 0, 1, 0.0f, 0.0f, 16777216.0f},
+    {"origin emitted", 0, 1, 0.0f, 0.0f, 1.0f},
+    {"point held", 0, 1, 0.0f, 0.0f, 1.0f},
+    {"last pushed depth", 0, 0, -INFINITY, -INFINITY, INFINITY},
+};
+
+#define FIELDS(a) a, sizeof a / sizeof a[0]
+static const PartLight PART_LIGHTS[] = {
+    {UMBRA_SHADOW_THRESHOLD, FIELDS(THRESHOLD_STATE), SHARES_DEPTH},
+    {UMBRA_SHADOW_CSSM, FIELDS(CSSM_STATE), SHARES_DEPTH_PER_CHANNEL},
+    {UMBRA_SHADOW_DEEP, FIELDS(DEEP_STATE), SHARES_PIECES},
+};
+#undef FIELDS
 
 static const PartLight *part_light(umbra_shadow_technique t)
 {
@@ -403,7 +432,10 @@ umbra_status umbra_renderer_render_part_into(umbra_renderer r, uint32_t width, u
 
 static uint32_t state_floats(umbra_renderer r, const PartLight *light)
 {
-    return light->state ? light->state : r->channels;
+    uint32_t n = 0;
+    for (uint32_t f = 0; f < light->field_count; ++f)
+        n += light->fields[f].per_channel ? r->channels : 1u;
+    return n;
 }
 
 static uint32_t depth_floats(umbra_renderer r, const PartLight *light)
@@ -413,26 +445,31 @@ static uint32_t depth_floats(umbra_renderer r, const PartLight *light)
                                                        : 0u;
 }
 
-/* The index into a PartLight's start/lo/hi/name of state float i. */
-static uint32_t state_slot(const PartLight *light, size_t i)
+/* The field of a texel's state float i (0 <= i < state_floats). */
+static const PartField *state_field(umbra_renderer r, const PartLight *light, uint32_t i)
 {
-    return light->state ? (uint32_t)(i % light->state) : 0u;
+    for (uint32_t f = 0;; ++f) {
+        const uint32_t w = light->fields[f].per_channel ? r->channels : 1u;
+        if (i < w || f + 1 == light->field_count)
+            return &light->fields[f];
+        i -= w;
+    }
 }
 
-/* An imported state's first bad value, refused naming its texel, channel and value. */
+/* An imported state's first bad value, refused naming its texel, field and value. */
 static umbra_status state_check(umbra_renderer r, const PartLight *light, const char *fn,
                                 const float *s, uint32_t n)
 {
     const uint32_t per = state_floats(r, light);
     for (size_t i = 0; i < (size_t)n * n * per; ++i) {
-        const uint32_t k = state_slot(light, i);
-        if (!(s[i] >= light->lo[k] && s[i] <= light->hi[k]))
+        const PartField *f = state_field(r, light, (uint32_t)(i % per));
+        if (!(s[i] >= f->lo && s[i] <= f->hi) || (f->integral && s[i] != floorf(s[i])))
             return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                               "%s: texel %zu (%zu, %zu): %s %g (state float %zu) must lie in "
+                               "%s: texel %zu (%zu, %zu): %s %g (state float %zu) must %s "
                                "[%g, %g] (technique %s's march state)", fn, i / per,
-                               i / per % n, i / per / n, light->name[k], (double)s[i], i % per,
-                               (double)light->lo[k], (double)light->hi[k],
-                               umbra_shadow_technique_name(light->technique));
+                               i / per % n, i / per / n, f->name, (double)s[i], i % per,
+                               f->integral ? "be an integer in" : "lie in", (double)f->lo,
+                               (double)f->hi, umbra_shadow_technique_name(light->technique));
     }
     return UMBRA_SUCCESS;
 }
@@ -492,7 +529,7 @@ umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index
             return umbra__fail(ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory",
                                "umbra_renderer_render_part");
         for (size_t i = 0; i < floats; ++i)
-            init[i] = light->start[state_slot(light, i)];
+            init[i] = state_field(r, light, (uint32_t)(i % per))->start;
         src = init;
     }
     size_t have = 0;
@@ -511,21 +548,14 @@ fail:
     return st;
 }
 
-umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_info *out)
+static umbra_status light_info(umbra_renderer r, const char *fn, umbra_part_light_info *out)
 {
-    CHECK_R();
-    if (!out || out->struct_size != sizeof *out)
-        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                           "%s: out %p must be non-NULL with struct_size %zu", __func__,
-                           (void *)out, sizeof *out);
-    memset(out, 0, sizeof *out);
-    out->struct_size = sizeof *out;
     if (r->shadow_set.technique == UMBRA_SHADOW_NONE) {
         out->kind = UMBRA_PART_LIGHT_NOTHING;
         return UMBRA_SUCCESS;
     }
     uint32_t n = 0;
-    umbra_status st = light_ready(r, __func__, &n);
+    umbra_status st = light_ready(r, fn, &n);
     if (st != UMBRA_SUCCESS)
         return st;
     const PartLight *light = part_light(r->shadow_set.technique);
@@ -535,7 +565,26 @@ umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_i
     out->depth_channels = depth_floats(r, light);
     out->tau_floats = (size_t)n * n * out->channels;
     out->depth_floats = (size_t)n * n * out->depth_channels;
+    out->node_floats = light->shares == SHARES_PIECES ? 1 + r->channels : 0;
     return UMBRA_SUCCESS;
+}
+
+umbra_status umbra_renderer_part_light_info(umbra_renderer r, umbra_part_light_info *out)
+{
+    CHECK_R();
+    /* The struct before node_floats (2026-12-03) is the smallest one taken. */
+    const size_t old_size = offsetof(umbra_part_light_info, node_floats);
+    if (!out || (out->struct_size != sizeof *out && out->struct_size != old_size))
+        return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "%s: out %p must be non-NULL with struct_size %zu (or %zu)", __func__,
+                           (void *)out, sizeof *out, old_size);
+    umbra_part_light_info info;
+    memset(&info, 0, sizeof info);
+    info.struct_size = out->struct_size;
+    umbra_status st = light_info(r, __func__, &info);
+    if (st == UMBRA_SUCCESS)
+        memcpy(out, &info, info.struct_size);
+    return st;
 }
 
 /* Builds the light structure if its inputs changed (the import of tau_in is one). */

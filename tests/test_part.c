@@ -34,6 +34,7 @@
 
 #include "part_scene.h"
 #include "techniques/deep.h"
+#include "techniques/deep_shared.h"
 #include "techniques/maps.h"
 
 /* The composited image's largest difference from one device's; *seq_differing counts the floats
@@ -391,18 +392,35 @@ static void test_bad_input_refused(void **state)
         umbra_part_light_info li = {.struct_size = sizeof li};
         assert_int_equal(umbra_renderer_part_light_info(r, &li), UMBRA_SUCCESS);
         assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU);
-        /* Its state is a visibility per light channel: one above 1 is refused naming the texel
-         * (the table in host/part_render.c, shared with threshold and CSSM). */
+        /* Its state is the whole march's (kernels/techniques/deep_shared.h): with one light
+         * channel 13 floats a texel, a node 2. A bad value is refused naming the texel, the
+         * field and the value (the table in host/part_render.c, shared with threshold and
+         * CSSM): a visibility above 1, a count that is not an integer, a NaN depth. */
+        assert_int_equal(li.channels, DEEP_PART_STATE_FLOATS(1));
+        assert_int_equal(li.node_floats, 2);
+        const size_t per = li.channels;
         float *vis = malloc(li.tau_floats * sizeof *vis);
         assert_non_null(vis);
-        for (size_t i = 0; i < li.tau_floats; ++i)
-            vis[i] = 1.0f;
-        vis[3] = 1.5f;
+        assert_int_equal(umbra_renderer_part_import_transmittance(r, NULL), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_export_transmittance(r, vis), UMBRA_SUCCESS);
+        assert_int_equal(umbra_renderer_part_import_transmittance(r, vis), UMBRA_SUCCESS);
+        vis[3 * per] = 1.5f;
         test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, vis),
                            UMBRA_ERROR_INVALID_ARGUMENT, "texel 3 (3, 0): visibility 1.5",
                            "[0, 1]");
+        vis[3 * per] = 1.0f;
+        vis[5 * per + 9] = 2.5f;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, vis),
+                           UMBRA_ERROR_INVALID_ARGUMENT,
+                           "texel 5 (5, 0): points since the origin 2.5", "be an integer");
+        vis[5 * per + 9] = 2.0f;
+        vis[6 * per + 1] = NAN;
+        test_assert_failed(ctx, umbra_renderer_part_import_transmittance(r, vis),
+                           UMBRA_ERROR_INVALID_ARGUMENT, "texel 6 (6, 0): fit origin depth nan",
+                           NULL);
+        assert_int_equal(umbra_renderer_part_import_transmittance(r, NULL), UMBRA_SUCCESS);
         free(vis);
-        const size_t texels = (size_t)li.map_size * li.map_size, nf = 1 + li.channels;
+        const size_t texels = (size_t)li.map_size * li.map_size, nf = li.node_floats;
         uint32_t *counts = malloc(texels * sizeof *counts);
         size_t k = 0;
         assert_non_null(counts);

@@ -386,7 +386,7 @@ static umbra_status exchange_pieces(MPI_Comm comm, MPI_Comm ordered, umbra_conte
                                     umbra_renderer r, const umbra_part_light_info *info,
                                     umbra_mpi_stats *stats)
 {
-    const size_t texels = (size_t)info->map_size * info->map_size, nf = 1 + info->channels;
+    const size_t texels = (size_t)info->map_size * info->map_size, nf = info->node_floats;
     int size = 1;
     MPI_Comm_size(ordered, &size);
     uint32_t *counts = malloc(texels * sizeof *counts);

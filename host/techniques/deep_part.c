@@ -4,7 +4,7 @@
  * of the texel's visibility function its core owns: the nodes of the segments of the light ray
  * inside its core (kernels/techniques/deep.cl under UMBRA_PART). The export reads them back in
  * texel order; the import merges the pieces of all parts per texel in depth order, which is one
- * device's function but for the compression's restart at each part's first segment, and lays
+ * device's function (the march state, its fit included, passes from part to part), and lays
  * the merged map out in blocks as a build lays it out (a tile's chain as long as its longest
  * texel's list needs), so the lookup is unchanged. */
 #include <math.h>

@@ -170,14 +170,20 @@ typedef struct umbra_part_light_info {
                                       whole segments' 1 - alpha and an optical depth); for CSSM
                                       the optical depth from the light per simulated light
                                       channel (1 grey, 3 coloured transmission; 0 reaching the
-                                      first part); for the deep map the visibility per light
-                                      channel (1 reaching the first part); a deep node is
-                                      1 + channels floats */
+                                      first part); for the deep map its whole march state,
+                                      6 light channels + 7 floats (the visibility and the
+                                      compression's open segment, in the order of
+                                      kernels/techniques/deep_shared.h; NULL imports the
+                                      light's for the first part) */
     uint32_t depth_channels;       /* floats per texel of the depth arrays: 1 for the threshold
                                       map, CSSM's channels (a photon depth per channel), 0 for
                                       the deep map (it exchanges pieces) */
     size_t tau_floats;             /* map_size^2 * channels, or 0 */
     size_t depth_floats;           /* map_size^2 * depth_channels, or 0 */
+    uint32_t node_floats;          /* floats per deep node of umbra_renderer_part_export_deep:
+                                      1 + light channels (a depth, then the visibility per
+                                      channel); 0 for the other techniques. A caller whose
+                                      struct_size ends before it gets the rest filled */
 } umbra_part_light_info;
 
 /* Describes the exchange the renderer's current technique and light need (the map size is

@@ -497,36 +497,28 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
 
 #if UMBRA_PART
     /* A part (host/part_render.c; one sub-ray, prefilter 1) marches the segments whose midpoint
-     * its core owns, from the visibility the parts before it on the ray left (part_state):
-     * the same segments, samples and products as one device's march. The segments it owns are
-     * consecutive (the core is convex); the first one after them ends its piece. */
+     * its core owns, going on from the whole march state the part before it on the ray left
+     * (deep_state_load: the visibility and the fit, held point and open segment included): the
+     * same segments, samples, points and fit as one device's march, so the parts' pieces join
+     * into one device's function node for node. The segments it owns are consecutive (the core
+     * is convex): the first segment in the box after them hands the ray on unfinished; where
+     * the ray ends (past its last segment, or its light below v_stop) the fit is finished here,
+     * as on one device. */
     {
         const DeepSub *s0 = &T->sub[0];
         const float a = fmax(t0, s0->ta), b = fmin(t1, s0->tb);
-        if (!(b > a) || !part_owns(F, world_to_voxel(g, s0->o + (0.5f * (a + b)) * s0->d))) {
+        const int inside = b > a;
+        if (inside ? !part_owns(F, world_to_voxel(g, s0->o + (0.5f * (a + b)) * s0->d))
+                   : !T->owned) {
             if (T->owned) {
-                deep_fit_finish(&T->fit, e, &ne);
-                T->done = 1;
-                return ne;
+                T->done = 1; /* handed on: the next part on the ray goes on from the state */
+                return 0;
             }
             T->k++;
             T->done = T->k >= T->k_end;
             return 0;
         }
-        if (!T->owned) {
-            T->owned = 1;
-            /* The piece starts at the segment's front end: the fit's origin is the visibility
-             * arriving there (the previous part's last node, at this depth); while it is 1 the
-             * origin slides along as on one device. */
-            const float z_front = (float)T->k * T->zstep;
-            T->fit.z0 = z_front;
-            if (!deep_all_one(T->sub[0].v)) {
-                T->fit.started = 1;
-                T->fit.v0 = T->sub[0].v;
-                T->fit.npts = 0;
-                T->z_pushed = z_front;
-            }
-        }
+        T->owned = 1;
     }
 #endif
     DeepPoints pts[DEEP_SUB_RAYS];
@@ -719,24 +711,55 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
  * large without the rest of the build's work. Every work-item reaches every barrier (texels
  * outside the map take part with nothing to march). */
 #if UMBRA_PART
-/* A part's light state per texel: the visibility of the texel's ray, UMBRA_LIGHT_CHANNELS
- * floats (host/part_render.c). */
-inline light_t deep_state_load(__global const float *state, int texel)
-{
+/* A part's march state per texel: DEEP_PART_FLOATS floats in the order of
+ * kernels/techniques/deep_shared.h (host/part_render.c checks an import against it). */
+#define DEEP_PART_FLOATS DEEP_PART_STATE_FLOATS(UMBRA_LIGHT_CHANNELS)
 #if UMBRA_LIGHT_CHANNELS == 1
-    return state[texel];
+#define DEEP_LOAD_V(s) ((s)[0])
+#define DEEP_STORE_V(s, v) ((s)[0] = (v))
 #else
-    return vload3(texel, state);
+#define DEEP_LOAD_V(s) vload3(0, (s))
+#define DEEP_STORE_V(s, v) vstore3((v), 0, (s))
 #endif
+
+inline void deep_state_load(DeepTexel *T, __global const float *state, int texel)
+{
+    const int C = UMBRA_LIGHT_CHANNELS;
+    __global const float *s = state + (size_t)texel * DEEP_PART_FLOATS;
+    DeepFit *f = &T->fit;
+    T->sub[0].v = DEEP_LOAD_V(s);
+    f->z0 = s[C];
+    f->v0 = DEEP_LOAD_V(s + C + 1);
+    f->zl = s[2 * C + 1];
+    f->vl = DEEP_LOAD_V(s + 2 * C + 2);
+    f->zh = s[3 * C + 2];
+    f->vh = DEEP_LOAD_V(s + 3 * C + 3);
+    f->lo = DEEP_LOAD_V(s + 4 * C + 3);
+    f->hi = DEEP_LOAD_V(s + 5 * C + 3);
+    f->npts = (int)s[6 * C + 3];
+    f->started = (int)s[6 * C + 4];
+    f->held = (int)s[6 * C + 5];
+    T->z_pushed = s[6 * C + 6];
 }
 
-inline void deep_state_store(__global float *state, int texel, light_t v)
+inline void deep_state_store(__global float *state, int texel, const DeepTexel *T)
 {
-#if UMBRA_LIGHT_CHANNELS == 1
-    state[texel] = v;
-#else
-    vstore3(v, texel, state);
-#endif
+    const int C = UMBRA_LIGHT_CHANNELS;
+    __global float *s = state + (size_t)texel * DEEP_PART_FLOATS;
+    const DeepFit *f = &T->fit;
+    DEEP_STORE_V(s, T->sub[0].v);
+    s[C] = f->z0;
+    DEEP_STORE_V(s + C + 1, f->v0);
+    s[2 * C + 1] = f->zl;
+    DEEP_STORE_V(s + 2 * C + 2, f->vl);
+    s[3 * C + 2] = f->zh;
+    DEEP_STORE_V(s + 3 * C + 3, f->vh);
+    DEEP_STORE_V(s + 4 * C + 3, f->lo);
+    DEEP_STORE_V(s + 5 * C + 3, f->hi);
+    s[6 * C + 3] = (float)f->npts;
+    s[6 * C + 4] = (float)f->started;
+    s[6 * C + 5] = (float)f->held;
+    s[6 * C + 6] = T->z_pushed;
 }
 #endif
 
@@ -773,9 +796,10 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
     if (gx < n && gy < n) {
         deep_texel_init(&st, S, g, (int2)(gx, gy), eps);
 #if UMBRA_PART
-        /* The visibility reaching the part on this ray (host/part_render.c); a ray whose light
-         * fell below the march's stop before it is done, as one device's march stopped. */
-        st.sub[0].v = deep_state_load(part_state, gy * n + gx);
+        /* The march state reaching the part on this ray (host/part_render.c); a ray whose light
+         * fell below the march's stop before it is done (and finished), as one device's march
+         * stopped. */
+        deep_state_load(&st, part_state, gy * n + gx);
         if (light_max(st.sub[0].v) < st.v_stop)
             st.done = 1;
 #endif
@@ -836,7 +860,7 @@ __kernel void deep_build(__global const UmbraFrame *F, VOLUME_PARAM,
     if (gx < n && gy < n) {
         counts[gy * n + gx] = written;
 #if UMBRA_PART
-        deep_state_store(part_state, gy * n + gx, st.sub[0].v);
+        deep_state_store(part_state, gy * n + gx, &st);
 #endif
     }
 }

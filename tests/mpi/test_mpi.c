@@ -35,8 +35,8 @@ enum { NX = 48, NY = 40, NZ = 36, BS = 8, W = 40, H = 36 };
  * march. */
 #define NONE_BOUND 1e-6f
 #define SHADOW_BOUND 1e-5f
-/* The deep map at epsilon 0.02: each part's compression restarts where the light ray enters it
- * (docs/distributed.md); tests/test_part.c holds the same bound. */
+/* The deep map at epsilon 0.02: the parts' march does not skip empty space, one device's does
+ * (docs/distributed.md); tests/test_part_maps.c holds the same bound. */
 #define DEEP_EPS_BOUND 0.01f
 
 static int rank, ranks, failures;
