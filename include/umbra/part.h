@@ -207,8 +207,9 @@ UMBRA_API umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r
 
 /* Sets the state reaching the part along each light ray (info.tau_floats floats, as the part
  * before it exported them; NULL: the light's, transmittance 1 and optical depth 0, for the first
- * part on every ray). Copied; the next build marches from it. A transmittance outside [0, 1], a
- * negative optical depth or NaN is refused naming the texel and the value. CSSM's photons of a
+ * part on every ray). Copied; the next build marches from it. A value outside its field's range
+ * (a transmittance or visibility outside [0, 1], a negative optical depth, a deep count that is
+ * not an integer) or NaN is refused naming the texel, the field and the value. CSSM's photons of a
  * ray block share a ray: the block's first texel's state is the one its build goes on from, and
  * the export writes the end state to every texel of the block. */
 UMBRA_API umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r,
