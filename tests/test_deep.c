@@ -736,13 +736,14 @@ static void test_camera_move_reuses_map_light_move_reuses_table(void **state)
 }
 
 /* Empty-space skipping of the light rays (whole bricks, and segments whose two ends lie in
- * sub-cells the light transfer function leaves empty, with jumps over them) changes what the fit
- * is fed -- no points in the skipped stretch -- so the nodes move within epsilon, but hardly the
- * picture: the spheres at 64x64 with skipping off and on, for the scene's light and a point light
- * above a corner, the unbounded map and a budget of 3 nodes, with and without the segment table
- * and with the 5-ray pre-filter. Measured: unbounded max |diff| <= 5.8e-4 (brick-level skipping
- * alone: 8e-6), bound 2e-3; with 3 nodes the budget's choice of nodes can flip for a texel (max
- * 0.079 with cells, 0.065 with bricks alone), so the mean: <= 3.5e-4, bound 1e-3. */
+ * sub-cells the light transfer function leaves empty, with jumps over them) changes nothing, bit
+ * for bit: a skipped segment is one the march would find flat, and a flat segment gives the fit
+ * no points either way (kernels/techniques/deep.cl, deep_step). The spheres at 64x64 with
+ * skipping off and on, for the scene's light and a point light above a corner, the unbounded map
+ * and a budget of 3 nodes, with and without the segment table and with the 5-ray pre-filter.
+ * Until 2026-12-03 the skip fed the fit no points where the march fed it flat ones, and its jumps
+ * located their exits afresh: the images differed by up to 5.8e-4 (unbounded) and 0.079 (3
+ * nodes, a flipped choice of nodes); the parts, which do not skip, inherited that difference. */
 static void test_skipping_changes_nothing(void **state)
 {
     umbra_context ctx = *state;
@@ -776,10 +777,7 @@ static void test_skipping_changes_nothing(void **state)
             printf("light %d, %s, table %d, prefilter %u: skipping on/off |diff| max %.2e, "
                    "mean %.2e\n", l, v & 1 ? "3 nodes" : "unbounded", mode != 1, d.deep.prefilter,
                    worst, mean);
-            if (v & 1)
-                assert_true(mean <= 1e-3);
-            else
-                assert_true(worst <= 2e-3);
+            assert_memory_equal(img[0], img[1], sizeof img[0]);
         }
     umbra_scene_release(&scene);
 }

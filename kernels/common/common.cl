@@ -553,6 +553,7 @@ inline float3 light_rgb(light_t v) { return (float3)(v); }
 inline float light_max(light_t v) { return v; }
 inline float light_min(light_t v) { return v; }
 inline int light_any_gt(light_t a, light_t b) { return a > b; } /* in any channel */
+inline int light_equal(light_t a, light_t b) { return a == b; }    /* in every channel */
 #else
 typedef float3 light_t;
 inline light_t light_absorbed(float4 c, uint flags)
@@ -563,6 +564,7 @@ inline float3 light_rgb(light_t v) { return v; }
 inline float light_max(light_t v) { return fmax(v.x, fmax(v.y, v.z)); }
 inline float light_min(light_t v) { return fmin(v.x, fmin(v.y, v.z)); }
 inline int light_any_gt(light_t a, light_t b) { return any(a > b); }
+inline int light_equal(light_t a, light_t b) { return all(a == b); }
 #endif
 
 /* Optical depth of len voxels of light transfer-function colour c, per light channel. */

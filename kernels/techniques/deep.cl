@@ -326,8 +326,9 @@ typedef struct DeepSub {
     float s_prev;   /* scalar at the current segment's front end, if has_prev */
     int has_prev;
     float3 xo, xd;  /* the ray in voxel coordinates (deep_point_class) */
-    float t_class;  /* the last segment's back end, and its class */
+    float t_class;  /* the last segment's back end, its class and its cell */
     int class_b;
+    int3 cell_b;
     float s_next;   /* scalar at the back end of segment k_next, sampled ahead */
     int k_next;     /* -1: none */
     light_t v;      /* visibility at the current segment's front end */
@@ -371,6 +372,7 @@ inline void deep_texel_init(DeepTexel *T, __global const UmbraShadow *S, VolGeom
         s->xd = d * g.inv_spacing;
         s->t_class = -UMBRA_INF;
         s->class_b = 0;
+        s->cell_b = (int3)(0);
         /* A ray that misses (or grazes) the box keeps an empty interval and its weight: lit. */
         s->ta = t.x;
         s->tb = (t.y > t.x && isfinite(t.x) && isfinite(t.y)) ? t.y : t.x;
@@ -421,7 +423,8 @@ inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
 }
 
 /* Where voxel position x lies for the empty-space test: 0 in a brick the light transfer function
- * leaves empty, 1 in an invisible sub-cell of a non-empty brick, 2 in a visible sub-cell. Cell j
+ * leaves empty, 1 in an invisible sub-cell of a non-empty brick, 2 in a visible sub-cell; *cell
+ * is the sub-cell's index on the whole grid of sub-cells (brick b's cell j: b CELLS + j). Cell j
  * of brick b covers the positions [b B + j C, b B + (j + 1) C) along each axis, C = ceil(B /
  * UMBRA_BRICK_CELLS), the border cells on to infinity (host/volume.c, compute_cells). Located
  * with the reciprocals of B and C (inv_B, inv_C) instead of divisions, last = (B - 1) / C
@@ -432,37 +435,38 @@ inline light_t deep_points_eval(const DeepPoints *p, light_t v0, float x)
  * ends located afresh every step) the test was a large part of a deep build in a profile;
  * this one and the cache in deep_step made builds cheaper (docs/performance.md; issue #12). */
 inline int deep_point_class(VolGeom g, __global const ulong *cells, float3 x, float inv_B,
-                            float inv_C, int last)
+                            float inv_C, int last, int3 *cell)
 {
     const int B = g.brick_size;
     const int3 b = clamp(convert_int3(x * inv_B), (int3)(0), g.bricks - 1);
+    const int3 c =
+        clamp(convert_int3((x - convert_float3(b * B)) * inv_C), (int3)(0), (int3)(last));
+    *cell = b * UMBRA_BRICK_CELLS + c;
     const ulong m = cells[(b.z * g.bricks.y + b.y) * g.bricks.x + b.x];
     if (!m)
         return 0;
-    const int3 c =
-        clamp(convert_int3((x - convert_float3(b * B)) * inv_C), (int3)(0), (int3)(last));
     const int bit = (c.z * UMBRA_BRICK_CELLS + c.y) * UMBRA_BRICK_CELLS + c.x;
     return 1 + (int)((m >> bit) & 1UL);
 }
 
-/* The ray parameter at which o + t d leaves the sub-cell containing o + t_now d (cells as in
- * deep_point_class; brick_exit's for cells). */
-inline float deep_cell_exit(VolGeom g, float3 o, float3 d, float t_now)
+/* The ray parameter at which xo + t xd (a sub-ray in voxel coordinates) leaves sub-cell `cell`
+ * (deep_point_class's index of it), or with whole set the brick that holds it. From the index
+ * the empty-space test found, not the position located afresh: located anew (with a division
+ * and a floor, in world coordinates), a point within rounding of a face could be put in the
+ * cell beyond it, and the march jumped to that cell's exit over a cell it had not tested (one
+ * device's map then differed from the march without the skip by 1.5e-4 in the image of a
+ * 512^3 volume, docs/distributed.md). The border cells and bricks extend to infinity. */
+inline float deep_exit(VolGeom g, float3 xo, float3 xd, int3 cell, int whole)
 {
-    const int B = g.brick_size, C = (B + UMBRA_BRICK_CELLS - 1) / UMBRA_BRICK_CELLS;
-    const int3 last = (int3)((B - 1) / C);
-    const float3 x = world_to_voxel(g, o + t_now * d);
-    const int3 b = clamp(convert_int3(floor(x / (float)B)), (int3)(0), g.bricks - 1);
-    const int3 c = clamp(convert_int3(floor((x - convert_float3(b * B)) / (float)C)), (int3)(0),
-                         last);
-    float3 lo = (convert_float3(b * B + c * C) + 0.5f) * g.spacing + g.box_min;
-    float3 hi = (convert_float3(b * B + min((c + 1) * C, (int3)(B))) + 0.5f) * g.spacing +
-                g.box_min;
-    /* The border cells extend to infinity, as the border bricks do. */
-    lo = select(lo, (float3)(-UMBRA_INF), (b == (int3)(0)) & (c == (int3)(0)));
-    hi = select(hi, (float3)(UMBRA_INF), (b == g.bricks - 1) & (c == last));
-    float3 t = select((lo - o) / d, (hi - o) / d, d > 0.0f);
-    t = select(t, (float3)(UMBRA_INF), d == 0.0f);
+    const int B = g.brick_size, C = g.cell_size, last = (B - 1) / C;
+    const int3 b = cell / UMBRA_BRICK_CELLS, c = cell - b * UMBRA_BRICK_CELLS;
+    const int3 lo_c = whole ? (int3)(0) : c, hi_c = whole ? (int3)(last) : c;
+    float3 lo = convert_float3(b * B + lo_c * C);
+    float3 hi = convert_float3(b * B + min((hi_c + 1) * C, (int3)(B)));
+    lo = select(lo, (float3)(-UMBRA_INF), (b == (int3)(0)) & (lo_c == (int3)(0)));
+    hi = select(hi, (float3)(UMBRA_INF), (b == g.bricks - 1) & (hi_c == (int3)(last)));
+    float3 t = select((lo - xo) / xd, (hi - xo) / xd, xd > 0.0f);
+    t = select(t, (float3)(UMBRA_INF), xd == 0.0f);
     return fmin(fmin(t.x, t.y), t.z);
 }
 
@@ -524,7 +528,8 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
     DeepPoints pts[DEEP_SUB_RAYS];
     light_t v_front[DEEP_SUB_RAYS]; /* each sub-ray's visibility at the segment's front end */
     light_t v_start = (light_t)(0.0f), v_end = (light_t)(0.0f);
-    int any_points = 0, all_empty = 1, all_cells_empty = 1;
+    /* flat: every point of every sub-ray leaves its visibility as it was at the front end. */
+    int any_points = 0, flat = 1, all_empty = 1, all_cells_empty = 1;
     for (int i = 0; i < DEEP_SUB_RAYS; ++i) {
         DeepSub *s = &T->sub[i];
         DeepPoints *p = &pts[i];
@@ -541,26 +546,37 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
         if (skip) {
             /* The front end's class is the previous segment's back end's when the two are the
              * same point (t1 is computed as the next t0 is, so they are, segment after segment). */
+            int3 ca, cb;
             const int ka = a == s->t_class ? s->class_b
                                            : deep_point_class(g, light_cells, s->xo + a * s->xd,
-                                                              inv_B, inv_C, last_cell);
-            const int kb =
-                deep_point_class(g, light_cells, s->xo + b * s->xd, inv_B, inv_C, last_cell);
+                                                              inv_B, inv_C, last_cell, &ca);
+            if (a == s->t_class)
+                ca = s->cell_b;
+            const int kb = deep_point_class(g, light_cells, s->xo + b * s->xd, inv_B, inv_C,
+                                            last_cell, &cb);
             s->t_class = b;
             s->class_b = kb;
-            if (ka == 0 && kb == 0) {
+            s->cell_b = cb;
+            /* The segment lies in its ends' sub-cells only if they are one cell or share a face
+             * (two face neighbours make a box); one that cuts across an edge or a corner passes
+             * through a third, which may be visible, and is marched. With that the skip is
+             * exact: the march that does not skip gives such a segment the same visibility, and
+             * a part (which does not skip) the same map. */
+            const uint3 dc = abs_diff(ca, cb);
+            const int within = dc.x + dc.y + dc.z <= 1u;
+            if (within && ka == 0 && kb == 0) {
                 /* Both ends in bricks the light transfer function leaves empty: transparent,
                  * and (if every sub-ray is) the march may jump to the bricks' exits below. */
                 s->has_prev = 0;
                 v_end += s->w * s->v;
                 continue;
             }
-            if (ka < 2 && kb < 2) {
+            if (within && ka < 2 && kb < 2) {
                 /* Both ends in sub-cells it leaves empty (kernels/common/umbra_shared.h):
-                 * transparent
-                 * too, as the threshold map's and CSSM's walks take them. Half the walnut's
-                 * segments in non-empty bricks are, and each saved a sample, a table entry and a
-                 * step of the fit. If every sub-ray is, the march jumps to the cells' exits. */
+                 * transparent too, as the threshold map's and CSSM's walks take them. Half the
+                 * walnut's segments in non-empty bricks are, and each saved a sample, a table
+                 * entry and a step of the fit. If every sub-ray is, the march jumps to the
+                 * cells' exits. */
                 all_empty = 0;
                 s->has_prev = 0;
                 v_end += s->w * s->v;
@@ -609,11 +625,19 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
             p->n++;
         }
         any_points = 1;
+        for (int j = 0; j < p->n; ++j)
+            flat &= light_equal(p->v[j], v_front[i]);
         s->v = p->v[p->n - 1];
         v_end += s->w * s->v;
     }
 
-    if (any_points) {
+    /* A flat segment gives the fit nothing, as a segment the empty-space skip jumps over gives
+     * it nothing: the next segment that is not flat starts with a point at its front end
+     * (below), and the fit's piece across the flat stretch is within epsilon of both its ends,
+     * so of the constant visibility between. A march that skips (one device) and one that does
+     * not (parts, UMBRA_FLAG_SKIP_EMPTY off) so feed the fit the same points wherever the
+     * skip's test is exact, and their maps agree at any epsilon (tests/test_part_maps.c). */
+    if (any_points && !flat) {
         /* The union of the sub-rays' positions, sorted, without repeats. */
         float xs[DEEP_MAX_POINTS];
         int nx = 0;
@@ -628,8 +652,8 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
                 xs[q] = x;
                 ++nx;
             }
-        /* A segment that follows empty ones starts with a point at its front end, so the fit
-         * sees the flat stretch before it as flat. */
+        /* A segment that follows empty or flat ones starts with a point at its front end, so
+         * the fit sees the flat stretch before it as flat. */
         float z_front = (float)T->k * T->zstep;
         if (z_front > T->z_pushed) {
             deep_fit_push(&T->fit, z_front, v_start, T->eps, e, &ne);
@@ -663,8 +687,10 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
             float tj;
             if (s->ta > t1)
                 tj = s->ta;
+            else if (s->t_class != t1)
+                tj = t1; /* t1 untested (the ray's entry): no jump */
             else
-                tj = fmin(deep_cell_exit(g, s->o, s->d, t1), s->tb);
+                tj = fmin(deep_exit(g, s->xo, s->xd, s->cell_b, 0), s->tb);
             /* A thousandth of a step short of the exit: a rounded exit past a segment's end must
              * not jump over a segment whose back end already lies in the next cell. */
             jump = fmin(jump, floor((tj - T->base) / h - 1e-3f));
@@ -681,9 +707,12 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
             float tj;
             if (s->ta > t1)
                 tj = s->ta; /* not entered yet: its entry */
+            else if (s->t_class != t1)
+                tj = t1;
             else
-                tj = fmin(brick_exit(g, s->o, s->d, t1), s->tb);
-            jump = fmin(jump, floor((tj - T->base) / h));
+                tj = fmin(deep_exit(g, s->xo, s->xd, s->cell_b, 1), s->tb);
+            /* A thousandth of a step short, as for the cells above. */
+            jump = fmin(jump, floor((tj - T->base) / h - 1e-3f));
         }
         if (jump > (float)k_next)
             k_next = (int)jump;
