@@ -17,9 +17,10 @@
  * Memory reported: used blocks x block bytes + the layout (heads, used blocks' next indices,
  * counts) + the table; for a fixed budget map_size^2 x N x node bytes + the table.
  *
- * The build kernels live in kernels/techniques/deep.cl next to the lookup (the fixed-budget one in
- * kernels/techniques/deep_budget.cl) but are compiled only into the build program
- * (DEEP_BUILD_KERNELS), not into every ray caster program. The map on parts (its pieces
+ * The build kernels live in kernels/techniques/deep.cl next to the lookup (the segment table's in
+ * kernels/techniques/deep_lut.cl, the fixed-budget one in kernels/techniques/deep_budget.cl) but
+ * are compiled only into the build program (DEEP_BUILD_KERNELS), not into every ray caster
+ * program. The map on parts (its pieces
  * exported and merged) is host/techniques/deep_part.c. */
 #include <math.h>
 #include <stdio.h>
@@ -87,8 +88,8 @@ static umbra_status create_buffer(umbra_context ctx, size_t bytes, const char *w
     return UMBRA_SUCCESS;
 }
 
-/* The build program (kernels/techniques/deep.cl with its build kernels switched on, without the ray
- * caster, so it does not depend on how the renderer assembles that one; the pre-filter's ray
+/* The build program (kernels/techniques/deep.cl with its build kernels switched on, then
+ * deep_lut.cl and deep_budget.cl, without the ray caster, so it does not depend on how the renderer assembles that one; the pre-filter's ray
  * count compiled in, DEEP_SUB_RAYS), its three kernels, and the tile edge the build's
  * work-group size allows. */
 static umbra_status ensure_program(umbra_renderer r, deep_state *s)
@@ -99,8 +100,9 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
                                          "common/channels.cl",
                                          "common/lightspace.cl"};
     const char *files[8];
-    const size_t nfiles = umbra__program_files(r->tech, common, 4, "techniques/deep_budget.cl",
-                                               files, 8);
+    size_t nfiles = umbra__program_files(r->tech, common, 4, "techniques/deep_lut.cl", files, 8);
+    if (nfiles < 8)
+        files[nfiles++] = "techniques/deep_budget.cl";
     char options[300];
     cl_program program;
     umbra__build_options(r, options, sizeof options - 48);
