@@ -20,8 +20,7 @@
  * The build kernels live in kernels/techniques/deep.cl next to the lookup (the segment table's in
  * kernels/techniques/deep_lut.cl, the fixed-budget one in kernels/techniques/deep_budget.cl) but
  * are compiled only into the build program (DEEP_BUILD_KERNELS), not into every ray caster
- * program. The map on parts (its pieces
- * exported and merged) is host/techniques/deep_part.c. */
+ * program. The map on parts (its pieces exported and merged) is host/techniques/deep_part.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,9 +88,9 @@ static umbra_status create_buffer(umbra_context ctx, size_t bytes, const char *w
 }
 
 /* The build program (kernels/techniques/deep.cl with its build kernels switched on, then
- * deep_lut.cl and deep_budget.cl, without the ray caster, so it does not depend on how the renderer assembles that one; the pre-filter's ray
- * count compiled in, DEEP_SUB_RAYS), its three kernels, and the tile edge the build's
- * work-group size allows. */
+ * deep_lut.cl and deep_budget.cl; without the ray caster, so it does not depend on how the
+ * renderer assembles that one; the pre-filter's ray count compiled in, DEEP_SUB_RAYS), its three
+ * kernels, and the tile edge the build's work-group size allows. */
 static umbra_status ensure_program(umbra_renderer r, deep_state *s)
 {
     umbra_context ctx = r->ctx;
