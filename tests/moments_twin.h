@@ -147,9 +147,10 @@ static inline int twin_bounds(const double *m, int n, double x0, double *lower, 
 
 /* The kernel's estimate of the optical depth in front of x0 (-1 < x0 < 1) from a record: b0
  * and the normalised moments mom[1..count], with the bias alpha and the overestimation beta
- * (moments.cl's mom_depth). Also the bounds it lies between, for the unbiased moments' measure:
- * b0 (lower - alpha F*) / (1 - alpha) and b0 (upper - alpha F*) / (1 - alpha), clamped to
- * [0, b0]. Returns 0 where twin_bounds does. */
+ * (moments.cl's mom_factor: the factor beta of the way from the bounds' lit end exp(-lo) to their
+ * dark end exp(-hi), as an optical depth). Also the bounds lo and hi it lies between, for the
+ * unbiased moments' measure: b0 (lower - alpha F*) / (1 - alpha) and b0 (upper - alpha F*) /
+ * (1 - alpha), clamped to [0, b0]. Returns 0 where twin_bounds does. */
 static inline int twin_depth(double b0, const double *mom, int count, double x0, double alpha,
                              double beta, double *estimate, double *lo, double *hi)
 {
@@ -164,7 +165,7 @@ static inline int twin_depth(double b0, const double *mom, int count, double x0,
 #define TWIN_CLAMP01(v) fmin(fmax((v), 0.0), 1.0)
     *lo = b0 * TWIN_CLAMP01((lower - alpha * fstar) / (1.0 - alpha));
     *hi = b0 * TWIN_CLAMP01((upper - alpha * fstar) / (1.0 - alpha));
-    *estimate = b0 * TWIN_CLAMP01((lower + beta * (upper - lower) - alpha * fstar) / (1.0 - alpha));
+    *estimate = -log(exp(-*lo) + beta * (exp(-*hi) - exp(-*lo)));
 #undef TWIN_CLAMP01
     return 1;
 }

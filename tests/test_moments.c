@@ -138,8 +138,11 @@ static void test_moments_twin_matches_kernel(void **state)
         {8, 32, UMBRA_TRANSMISSION_GREY},   {6, 16, UMBRA_TRANSMISSION_GREY},
         {6, 32, UMBRA_TRANSMISSION_COLORED},
     };
-    /* Measured on PoCL: worst 2.9e-5 (4 and 8 moments), 1e-5 (6); bound: */
-    const double tol = 1e-4; /* on the optical depth, times (1 + b0) */
+    /* Measured on PoCL (2026-12-03): worst 1.3e-4 (4 moments, one point whose estimate rests on
+     * the lower bound alone: its lit end outweighs the dark one), 5.7e-5 (8), 2.6e-5 (6), mean
+     * 2e-6; the twin placing its estimate between the optical depth's bounds instead of the
+     * factor's (this map's estimate before 2026-12-03) is off by 0.27 (4 moments). Bound: */
+    const double tol = 3e-4; /* on the optical depth, times (1 + b0) */
     for (size_t ci = 0; ci < sizeof cases / sizeof cases[0]; ++ci) {
         umbra_shadow_desc s = mt_shadow(UMBRA_SHADOW_MOMENTS, MAP, 1);
         s.moments.count = cases[ci].count;
@@ -205,6 +208,7 @@ static void test_moments_bound_holds_against_reference(void **state)
         assert_int_equal(umbra_renderer_set_shadow(b.r, &ref), UMBRA_SUCCESS);
         assert_int_equal(umbra_renderer_query_shadow(b.r, b.points, b.count, fr), UMBRA_SUCCESS);
         double worst_out = 0.0, err_sum = 0.0, width_sum = 0.0, worst_est = 0.0;
+        double ferr_sum = 0.0, fwidth_sum = 0.0; /* the same of the factor */
         size_t used = 0, lit = 0;
         for (size_t p = 0; p < b.count; ++p) {
             double mom[UMBRA_MOMENTS_MAX + 1], est, lo, hi;
@@ -226,18 +230,25 @@ static void test_moments_bound_holds_against_reference(void **state)
             worst_est = fmax(worst_est, fmax(lo - t_k, t_k - hi) - 2e-3 * (1.0 + b0));
             err_sum += fabs(t_k - t_ref);
             width_sum += hi - lo;
+            ferr_sum += fabs((double)b.factors[3 * p] - (double)fr[3 * p]);
+            fwidth_sum += exp(-lo) - exp(-hi);
             ++used;
         }
         print_message("beta %.2f: %zu points; reference outside the bounds by at most %.2e "
                       "beyond the allowance; estimate outside by %.2e; mean |error| %.4f, mean "
-                      "bounds' width %.4f (optical depth); %zu exactly lit\n",
+                      "bounds' width %.4f (optical depth); factor: mean |error| %.4f, mean "
+                      "bounds' width %.4f; %zu exactly lit\n",
                       betas[bi], used, worst_out, worst_est, err_sum / (double)used,
-                      width_sum / (double)used, lit);
+                      width_sum / (double)used, ferr_sum / (double)used,
+                      fwidth_sum / (double)used, lit);
         assert_true(used > b.count / 8);
         assert_true(worst_out <= 0.0);
         assert_true(worst_est <= 0.0);
-        /* The error stays within what the bound allows: max(beta, 1 - beta) of the width. */
-        assert_true(err_sum <= fmax(betas[bi], 1.0 - betas[bi]) * width_sum + 0.02 * used);
+        /* The error stays within what the bound allows: max(beta, 1 - beta) of the width, of
+         * the optical depth and of the factor (the estimate's own bound, moments.cl). */
+        const double most = fmax(betas[bi], 1.0 - betas[bi]);
+        assert_true(err_sum <= most * width_sum + 0.02 * used);
+        assert_true(ferr_sum <= most * fwidth_sum + 0.01 * used);
         if (betas[bi] == 0.0f)
             assert_true(lit > 0);
         free(fr);

@@ -98,8 +98,9 @@ static const umbra__param params[] = {
                        .flags = UMBRA_PARAM_ZERO, .default_value = 0, .min = 1e-8, .max = 0.1,
                        .zero_doc = "the technique's own for the count and bits"),
     UMBRA__PARAM_KEYED(moments, overestimation, "moment_overestimation",
-                       .doc = "where the estimated optical depth in front of a sample lies "
-                              "between its lower bound (0) and its upper bound (1)",
+                       .doc = "where the estimated shadow factor lies between its bounds' "
+                              "lit end (0: the optical depth's lower bound) and dark end (1: "
+                              "its upper bound); 0.5, the midpoint, errs least at worst",
                        .default_value = 0.5, .min = 0, .max = 1),
     UMBRA__PARAM_KEYED(moments, blur, "moment_blur",
                        .doc = "radius of a separable binomial pre-filter over the built map "
@@ -112,13 +113,16 @@ static const umbra__param params[] = {
  * for equal memory with the other maps' 512^2 rows (docs/moments.md): 296^2 at 4 moments and
  * 16 bits (12 bytes per texel and channel) holds what CSSM's 512^2 holds (4); 512^2 at 6 moments
  * and 16 bits (16 bytes per texel and channel) what the deep map's 512^2 with 3 nodes holds in
- * colour (a node of a depth and three channels is 16 bytes: 48 bytes per texel). The headline
- * row: 512^2 at the defaults (6 moments, 32 bits). */
+ * colour (a node of a depth and three channels is 16 bytes: 48 bytes per texel), also at the
+ * deep map's light step of half a voxel, so that the two compare at equal memory and equal
+ * sampling. The headline row: 512^2 at the defaults (6 moments, 32 bits). */
 #define Q (UMBRA__SWEEP_QUICK | UMBRA__SWEEP_FULL)
 static const umbra__setting sweep[] = {
     {"", "moments", UMBRA__SWEEP_BUILDS},
     {"map_size=296;moments=4;moment_bits=16", "296², 4 moments, 16 bits", Q},
     {"map_size=512;moments=6;moment_bits=16", "512², 6 moments, 16 bits", Q},
+    {"map_size=512;moments=6;moment_bits=16;map_step=0.5", "512², 6 moments, 16 bits, step 0.5",
+     Q},
     {"map_size=256;moments=6", "256², 6 moments", Q},
     {"map_size=512;moments=6", "512², 6 moments",
      Q | UMBRA__SWEEP_HEADLINE | UMBRA__SWEEP_HEADLINE_QUICK},

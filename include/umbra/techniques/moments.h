@@ -20,9 +20,10 @@ typedef struct umbra_moments_desc {
                              weight with those of a uniform spread, which keeps the
                              reconstruction well posed under rounding; 0 (the default): the
                              technique's own for the count and bits. Read by the lookup only */
-    float overestimation; /* in [0, 1] (default 0.5): where the estimate lies between the lower
-                             (0) and the upper (1) bound of the optical depth in front of a
-                             sample. Read by the lookup only */
+    float overestimation; /* in [0, 1] (default 0.5): where the estimated shadow factor lies
+                             between its bounds' lit end (0: the lower bound of the optical
+                             depth in front of a sample) and dark end (1: the upper bound).
+                             Read by the lookup only */
     uint32_t blur;        /* radius in texels, 0..4 (default 0: none), of a separable binomial
                              pre-filter over the built map (moments filter linearly) */
 } umbra_moments_desc;
