@@ -157,12 +157,20 @@ typedef struct measurement {
     umbra_render_stats stats;
 } measurement;
 
-/* The scene's options with the setting's pre-integration, then the setting's shadow. */
+/* The scene's options with the setting's pre-integration, then the setting's shadow, set after
+ * technique none so that the technique's state starts afresh: the memory a setting reports is
+ * then its own, not also what an earlier setting left cached (the deep map keeps the segment
+ * table of another light step, a draft's, for interaction auto). */
 static umbra_status set_config(scene_ctx *S, const config *c)
 {
     umbra_render_desc o = S->scene.options;
     o.preintegrated = c->preintegrated;
     umbra_status st = umbra_renderer_set_options(S->r, &o);
+    umbra_shadow_desc none;
+    umbra_shadow_desc_init(&none);
+    none.technique = UMBRA_SHADOW_NONE;
+    if (st == UMBRA_SUCCESS)
+        st = umbra_renderer_set_shadow(S->r, &none);
     return st == UMBRA_SUCCESS ? umbra_renderer_set_shadow(S->r, &c->desc) : st;
 }
 
