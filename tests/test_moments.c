@@ -138,8 +138,7 @@ static void test_moments_twin_matches_kernel(void **state)
         {8, 32, UMBRA_TRANSMISSION_GREY},   {6, 16, UMBRA_TRANSMISSION_GREY},
         {6, 32, UMBRA_TRANSMISSION_COLORED},
     };
-    /* Measured on PoCL (2026-12-03): worst 1.3e-4 (4 moments, one point whose estimate rests on
-     * the lower bound alone: its lit end outweighs the dark one), 5.7e-5 (8), 2.6e-5 (6), mean
+    /* Measured on PoCL (2026-12-03): worst 1.3e-4 (4 moments), 5.7e-5 (8), 2.6e-5 (6), mean
      * 2e-6; the twin placing its estimate between the optical depth's bounds instead of the
      * factor's (this map's estimate before 2026-12-03) is off by 0.27 (4 moments). Bound: */
     const double tol = 3e-4; /* on the optical depth, times (1 + b0) */
