@@ -432,9 +432,13 @@ UMBRA_INLINE int mom_roots(const float *c_in, const int deg, float *r)
     const float sq = sqrt(fmax(Q, 0.0f));
     const float cosarg = Q > 0.0f ? clamp(R / (Q * sq), -1.0f, 1.0f) : 0.0f;
     const float th = acos(cosarg) / 3.0f, sc = -2.0f * sq, shift = a3 / 3.0f;
-    r[0] = sc * cos(th) - shift;
-    r[1] = sc * cos(th + 2.0943951f) - shift;
-    r[2] = sc * cos(th - 2.0943951f) - shift;
+    float cth;
+    const float sth = sincos(th, &cth);
+    /* cos(th -+ 2 pi / 3) = -cos(th) / 2 +- sin(th) sqrt(3) / 2: one sincos for three cosines */
+    const float mid = -0.5f * cth, side = 0.8660254f * sth;
+    r[0] = sc * cth - shift;
+    r[1] = sc * (mid - side) - shift;
+    r[2] = sc * (mid + side) - shift;
     return deg;
 }
 
