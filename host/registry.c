@@ -486,14 +486,14 @@ int umbra__draft_desc(const umbra__technique *t, const umbra_shadow_desc *desc,
 }
 
 size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,
-                            const char *last, const char **files, size_t max)
+                            const char *const *after, const char **files, size_t max)
 {
     size_t n = 0;
     for (size_t i = 0; i < ncommon && n < max; ++i)
         files[n++] = common[i];
     for (const char *const *f = t->kernel_files; f && *f && n < max; ++f)
         files[n++] = *f;
-    if (last && n < max)
-        files[n++] = last;
+    for (const char *const *f = after; f && *f && n < max; ++f)
+        files[n++] = *f;
     return n;
 }

@@ -554,7 +554,8 @@ umbra_status umbra__raycast_kernels(umbra_renderer r)
                                          "common/channels.cl",
                                          "common/lightspace.cl", "common/preintegration.cl"};
     const char *files[16];
-    const size_t nfiles = umbra__program_files(r->tech, common, 5, "raycast.cl", files, 16);
+    static const char *const after[] = {"raycast.cl", NULL};
+    const size_t nfiles = umbra__program_files(r->tech, common, 5, after, files, 16);
     cl_program program;
     umbra__build_options(r, options, sizeof options);
     umbra_status st = umbra__program_get(r->ctx, files, nfiles, options, &program);

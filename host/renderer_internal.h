@@ -467,10 +467,10 @@ umbra_status umbra__bind_common(umbra_renderer r, cl_kernel k, cl_uint *next);
 const umbra__technique *umbra__technique_by_id(umbra_shadow_technique id);
 
 /* The technique's own kernel files (t->kernel_files) inserted into a program's file list: the
- * common files first, then the technique's, then `last` (may be NULL); returns the count, at most
- * max (the caller's array). */
+ * common files first, then the technique's, then those of `after` (NULL-terminated; may be NULL);
+ * returns the count, at most max (the caller's array). */
 size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,
-                            const char *last, const char **files, size_t max);
+                            const char *const *after, const char **files, size_t max);
 
 /* Refuses, naming fn, a desc whose parameters of technique t (and the shared map's, for a map)
  * lie outside their ranges; then t's own validate. */

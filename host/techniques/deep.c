@@ -98,10 +98,10 @@ static umbra_status ensure_program(umbra_renderer r, deep_state *s)
     static const char *const common[] = {"common/common.cl", "common/sampling.cl",
                                          "common/channels.cl",
                                          "common/lightspace.cl"};
-    const char *files[8];
-    size_t nfiles = umbra__program_files(r->tech, common, 4, "techniques/deep_lut.cl", files, 8);
-    if (nfiles < 8)
-        files[nfiles++] = "techniques/deep_budget.cl";
+    static const char *const after[] = {"techniques/deep_lut.cl", "techniques/deep_budget.cl",
+                                        NULL};
+    const char *files[16];
+    const size_t nfiles = umbra__program_files(r->tech, common, 4, after, files, 16);
     char options[300];
     cl_program program;
     umbra__build_options(r, options, sizeof options - 48);
