@@ -15,6 +15,7 @@
 #include "lightspace.h"
 #include "renderer_internal.h"
 #include "techniques/deep.h"
+#include "techniques/deep_shared.h"
 #include "techniques/maps.h"
 
 static const char *const AXIS = "xyz";
@@ -479,6 +480,41 @@ static int is_deep(umbra_renderer r)
     return r->shadow_set.technique == UMBRA_SHADOW_DEEP;
 }
 
+/* The deep march state's fields (DEEP_STATE) that must agree with each other, beyond each lying
+ * in its own range: exactly what every march leaves (kernels/techniques/deep.cl, deep_fit_feed),
+ * so no state a part exported is refused. Until the fit's origin node is emitted no point has
+ * been fed and the origin's visibility is 1; once points are fed, the window of slopes that
+ * keeps them within tolerance is not empty (lowest <= highest: the windows are intersected only
+ * while they overlap, and a point's own window always holds its exact slope). A state that
+ * breaks either is none a march could leave, and the part would go on from a fit that no single
+ * device's march ever holds. Run after state_check, so every value is a number. */
+static umbra_status deep_state_check(umbra_renderer r, const char *fn, const float *s, uint32_t n)
+{
+    const uint32_t C = r->channels, per = DEEP_PART_STATE_FLOATS(C);
+    const uint32_t v0 = C + 1, lo = 4 * C + 3, hi = 5 * C + 3, npts = 6 * C + 3;
+    const uint32_t started = npts + 1;
+    for (size_t t = 0; t < (size_t)n * n; ++t) {
+        const float *x = s + t * per;
+        for (uint32_t c = 0; c < C; ++c) {
+            const char *why = NULL;
+            if (x[started] == 0.0f && x[npts] != 0.0f)
+                why = "points since the origin must be 0 while the origin is not emitted";
+            else if (x[started] == 0.0f && x[v0 + c] != 1.0f)
+                why = "fit origin visibility must be 1 while the origin is not emitted";
+            else if (x[npts] > 0.0f && !(x[lo + c] <= x[hi + c]))
+                why = "lowest slope must not exceed the highest once points are fed";
+            if (why)
+                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                                   "%s: texel %zu (%zu, %zu), channel %u: %s (points %g, origin "
+                                   "emitted %g, origin visibility %g, slopes [%g, %g]; technique "
+                                   "deep's march state)", fn, t, t % n, t / n, c, why,
+                                   (double)x[npts], (double)x[started], (double)x[v0 + c],
+                                   (double)x[lo + c], (double)x[hi + c]);
+        }
+    }
+    return UMBRA_SUCCESS;
+}
+
 static umbra_status light_unsupported(umbra_renderer r, const char *fn)
 {
     const char *tech = umbra_shadow_technique_name(r->shadow_set.technique);
@@ -649,7 +685,8 @@ umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r, const fl
     const size_t floats = (size_t)n * n * state_floats(r, light);
     float *copy = NULL;
     if (tau_in) {
-        if ((st = state_check(r, light, fn, tau_in, n)) != UMBRA_SUCCESS)
+        if ((st = state_check(r, light, fn, tau_in, n)) != UMBRA_SUCCESS ||
+            (is_deep(r) && (st = deep_state_check(r, fn, tau_in, n)) != UMBRA_SUCCESS))
             return st;
         if (!(copy = malloc(floats * sizeof *copy)))
             return umbra__fail(r->ctx, UMBRA_ERROR_OUT_OF_MEMORY, "%s: out of host memory", fn);

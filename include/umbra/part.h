@@ -209,7 +209,9 @@ UMBRA_API umbra_status umbra_renderer_part_export_transmittance(umbra_renderer r
  * before it exported them; NULL: the light's, transmittance 1 and optical depth 0, for the first
  * part on every ray). Copied; the next build marches from it. A value outside its field's range
  * (a transmittance or visibility outside [0, 1], a negative optical depth, a deep count that is
- * not an integer) or NaN is refused naming the texel, the field and the value. CSSM's photons of a
+ * not an integer) or NaN is refused naming the texel, the field and the value, and so is a deep
+ * state whose fields no march leaves together (points fed before the fit's origin is emitted, an
+ * origin visibility below 1 before it is, an empty window of slopes). CSSM's photons of a
  * ray block share a ray: the block's first texel's state is the one its build goes on from, and
  * the export writes the end state to every texel of the block. */
 UMBRA_API umbra_status umbra_renderer_part_import_transmittance(umbra_renderer r,
