@@ -267,11 +267,11 @@ void umbra__build_options(umbra_renderer r, char *buf, size_t size)
     umbra_scalar_type t = r->volume ? r->volume->stored_type : UMBRA_FLOAT32;
     const int image = r->volume ? umbra__volume_images(r->volume)
                                 : r->ctx->sampler == UMBRA_SAMPLER_IMAGE;
+    const int kind = t <= UMBRA_FLOAT32 ? (int)t : (int)UMBRA_FLOAT32;
     int n = snprintf(buf, size,
                      "-DUMBRA_SAMPLER_IMAGE=%d -DUMBRA_LIGHT_CHANNELS=%u -DUMBRA_VOXEL_T=%s "
-                     "-DUMBRA_VOXEL_CLAMPS=%d",
-                     image, r->channels, voxel_t[t <= UMBRA_FLOAT32 ? t : UMBRA_FLOAT32],
-                     r->volume ? r->volume->clamps : 1);
+                     "-DUMBRA_VOXEL_KIND=%d -DUMBRA_VOXEL_CLAMPS=%d",
+                     image, r->channels, voxel_t[kind], kind, r->volume ? r->volume->clamps : 1);
     /* A multi-channel volume or a label map (kernels/common/channels.cl); a plain volume adds
      * nothing, so its programs stay what they were. */
     if (r->volume && (r->volume->channels > 1 || r->volume->labels) && n > 0 && (size_t)n < size)

@@ -35,6 +35,9 @@
 #ifndef UMBRA_VOXEL_T
 #define UMBRA_VOXEL_T float
 #endif
+#ifndef UMBRA_VOXEL_KIND
+#define UMBRA_VOXEL_KIND -1 /* umbra_scalar_type of UMBRA_VOXEL_T; -1: not given, generic loads */
+#endif
 #ifndef UMBRA_VOXEL_CLAMPS
 #define UMBRA_VOXEL_CLAMPS 1
 #endif
@@ -170,6 +173,46 @@ UMBRA_INLINE float2 voxel_load2(__global const UMBRA_VOXEL_T *restrict v, VolGeo
 #endif
 }
 
+/* The eight corners of a trilinear cell as voxel_load values: the voxel pairs (i, i + 1) at
+ * b, b + oy, b + oz and b + oz + oy, their first voxels in lo and their second in hi. An integer
+ * voxel type (UMBRA_VOXEL_KIND 0-2: uchar, ushort, short) loads each pair as one word and
+ * splits the four words with vector shifts: PoCL's code for four separate pairs extracted and
+ * converted every voxel on its own, a quarter of the instructions of a sample
+ * (docs/performance.md). The same values either way: the conversions are exact. */
+UMBRA_INLINE void voxel_load_corners(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t b,
+                                     size_t oy, size_t oz, float4 *lo, float4 *hi)
+{
+#if UMBRA_VOXEL_KIND == 0 || UMBRA_VOXEL_KIND == 1 || UMBRA_VOXEL_KIND == 2
+#if UMBRA_VOXEL_KIND == 0
+#define UMBRA_PAIR(i) (uint)as_ushort(vload2(0, v + (i)))
+#else
+#define UMBRA_PAIR(i) as_uint(vload2(0, v + (i)))
+#endif
+    const uint4 w = (uint4)(UMBRA_PAIR(b), UMBRA_PAIR(b + oy), UMBRA_PAIR(b + oz),
+                            UMBRA_PAIR(b + oz + oy));
+#undef UMBRA_PAIR
+#if UMBRA_VOXEL_KIND == 0
+    *lo = convert_float4(w & 0xffu);
+    *hi = convert_float4(w >> 8);
+#elif UMBRA_VOXEL_KIND == 1
+    *lo = convert_float4(w & 0xffffu);
+    *hi = convert_float4(w >> 16);
+#else
+    *lo = convert_float4((as_int4(w) << 16) >> 16);
+    *hi = convert_float4(as_int4(w) >> 16);
+#endif
+#if UMBRA_VOXEL_CLAMPS
+    *lo = clamp((*lo * g.image_scale - g.value_lo) * g.value_scale, 0.0f, 1.0f);
+    *hi = clamp((*hi * g.image_scale - g.value_lo) * g.value_scale, 0.0f, 1.0f);
+#endif
+#else
+    const float2 c0 = voxel_load2(v, g, b), c1 = voxel_load2(v, g, b + oy);
+    const float2 c2 = voxel_load2(v, g, b + oz), c3 = voxel_load2(v, g, b + oz + oy);
+    *lo = (float4)(c0.x, c1.x, c2.x, c3.x);
+    *hi = (float4)(c0.y, c1.y, c2.y, c3.y);
+#endif
+}
+
 /* A blend of voxel_load values, normalised. */
 UMBRA_INLINE float voxel_blended(VolGeom g, float b)
 {
@@ -247,11 +290,13 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     const size_t sy = (size_t)PART_DIMS.x, sz = (size_t)PART_DIMS.x * (size_t)PART_DIMS.y;
     const size_t b = (size_t)i0.z * sz + (size_t)i0.y * sy + (size_t)i0.x;
     const size_t oy = (size_t)(i1.y - i0.y) * sy, oz = (size_t)(i1.z - i0.z) * sz;
-    float2 c0 = voxel_load2(v, g, b), c1 = voxel_load2(v, g, b + oy);
-    float2 c2 = voxel_load2(v, g, b + oz), c3 = voxel_load2(v, g, b + oz + oy);
-    float c00 = mix(c0.x, c0.y, f.x), c10 = mix(c1.x, c1.y, f.x);
-    float c01 = mix(c2.x, c2.y, f.x), c11 = mix(c3.x, c3.y, f.x);
-    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+    float4 lo, hi;
+    voxel_load_corners(v, g, b, oy, oz, &lo, &hi);
+    /* The four x blends (c00, c10, c01, c11), then the two y blends, then z: per element the
+     * same mix, in the same order, as one corner at a time. */
+    const float4 bx = mix(lo, hi, f.x);
+    const float2 by = mix(bx.s02, bx.s13, f.y);
+    return mix(by.x, by.y, f.z);
 }
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
