@@ -266,7 +266,11 @@ UMBRA_INLINE __global const UMBRA_VOXEL_T *volume_slab(VOLUME_PARAM, int s)
  * where the range clamps voxels, else stored values (voxel_blended maps them). */
 UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
 {
-    x = clamp(x, (float3)(0.0f), convert_float3(g.dims - 1));
+    /* clamp(x, 0, dims - 1) as two compares and selects: clamp's NaN rules cost PoCL four
+     * instructions more, and a NaN comes out 0 either way. */
+    const float3 top = convert_float3(g.dims - 1);
+    x = select((float3)(0.0f), x, x > 0.0f);
+    x = select(top, x, x < top);
     /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
      * negative and huge values), a conversion one. */
     int3 i0 = convert_int3(x);
