@@ -272,9 +272,12 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     x = select((float3)(0.0f), x, x > 0.0f);
     x = select(top, x, x < top);
     /* x >= 0, so truncation is floor, exactly: PoCL's floor() is a dozen instructions (it handles
-     * negative and huge values), a conversion one. */
-    int3 i0 = convert_int3(x);
-    float3 f = x - convert_float3(i0);
+     * negative and huge values), a conversion one. Converted as four lanes: PoCL split a float3's
+     * conversions into a scalar one and a vector one and shuffled them together. */
+    const float4 x4 = (float4)(x, 0.0f);
+    const int4 j0 = convert_int4(x4);
+    const float3 f = (x4 - convert_float4(j0)).xyz;
+    int3 i0 = j0.xyz;
     int3 i1 = min(i0 + 1, g.dims - 1);
 #if UMBRA_PART
     i0 = PART_INDEX(i0);
