@@ -299,11 +299,14 @@ UMBRA_INLINE float sample_stored(VOLUME_PARAM, VolGeom g, float3 x)
     const size_t oy = (size_t)(i1.y - i0.y) * sy, oz = (size_t)(i1.z - i0.z) * sz;
     float4 lo, hi;
     voxel_load_corners(v, g, b, oy, oz, &lo, &hi);
-    /* The four x blends (c00, c10, c01, c11), then the two y blends, then z: per element the
-     * same mix, in the same order, as one corner at a time. */
-    const float4 bx = mix(lo, hi, f.x);
-    const float2 by = mix(bx.s02, bx.s13, f.y);
-    return mix(by.x, by.y, f.z);
+    /* The four x blends (c00, c10, c01, c11), then the two y blends, then z, each a + t (b - a)
+     * as one fused multiply-add: mix's multiply and add are two dependent steps on the chain
+     * from the loads to the view table's entry, and the fused form is 5% of the walnut's
+     * unshaded frame (docs/performance.md); fma is correctly rounded on every device, and the
+     * C twin (tests/reference/cpu_reference.c, lerp_fma) blends the same way. */
+    const float4 bx = fma(f.x, hi - lo, lo);
+    const float2 by = fma(f.y, bx.s13 - bx.s02, bx.s02);
+    return fma(f.z, by.y - by.x, by.x);
 }
 
 inline float sample_volume(VOLUME_PARAM, VolGeom g, float3 p)
@@ -388,7 +391,8 @@ UMBRA_INLINE float4 tf_classify(__global const float4 *tf, TfMap m, float s)
     float x = clamp(fma(s, m.a, m.b), 0.0f, m.top);
     int i = (int)x;
     float f = x - (float)i;
-    return mix(tf[i], tf[i + 1], f);
+    const float4 a = tf[i];
+    return fma(f, tf[i + 1] - a, a); /* fused, as sample_stored's blends */
 }
 
 #if UMBRA_SAMPLER_IMAGE || UMBRA_VOLUME_SLABS > 1

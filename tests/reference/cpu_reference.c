@@ -24,6 +24,9 @@ static v3 cross(v3 a, v3 b) { return mk(a.y * b.z - a.z * b.y, a.z * b.x - a.x *
 static v3 norm(v3 a) { float l = sqrtf(dot(a, a)); return l > 0 ? mul(a, 1.0f / l) : a; }
 static v3 from(const float *p) { return mk(p[0], p[1], p[2]); }
 static float lerp(float a, float b, float t) { return a + (b - a) * t; }
+/* The kernels' blend of the trilinear sample and the view table (kernels/common/sampling.cl):
+ * one rounding fewer than lerp, the same on every device (fmaf is correctly rounded). */
+static float lerp_fma(float a, float b, float t) { return fmaf(t, b - a, a); }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
 /* Everything derived once per render. */
@@ -67,12 +70,12 @@ static float sample_voxel(const prep *P, v3 xv)
     }
     size_t sy = (size_t)s->dims[0], sz = (size_t)s->dims[0] * s->dims[1];
 #define V(X, Y, Z) s->voxels[(size_t)(Z) * sz + (size_t)(Y) * sy + (size_t)(X)]
-    float c00 = lerp(V(i0[0], i0[1], i0[2]), V(i1[0], i0[1], i0[2]), f[0]);
-    float c10 = lerp(V(i0[0], i1[1], i0[2]), V(i1[0], i1[1], i0[2]), f[0]);
-    float c01 = lerp(V(i0[0], i0[1], i1[2]), V(i1[0], i0[1], i1[2]), f[0]);
-    float c11 = lerp(V(i0[0], i1[1], i1[2]), V(i1[0], i1[1], i1[2]), f[0]);
+    float c00 = lerp_fma(V(i0[0], i0[1], i0[2]), V(i1[0], i0[1], i0[2]), f[0]);
+    float c10 = lerp_fma(V(i0[0], i1[1], i0[2]), V(i1[0], i1[1], i0[2]), f[0]);
+    float c01 = lerp_fma(V(i0[0], i0[1], i1[2]), V(i1[0], i0[1], i1[2]), f[0]);
+    float c11 = lerp_fma(V(i0[0], i1[1], i1[2]), V(i1[0], i1[1], i1[2]), f[0]);
 #undef V
-    return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
+    return lerp_fma(lerp_fma(c00, c10, f[1]), lerp_fma(c01, c11, f[1]), f[2]);
 }
 
 static float sample(const prep *P, v3 p) { return sample_voxel(P, to_voxel(P, p)); }
@@ -94,7 +97,7 @@ static void view_lookup(const float *tf, int n, float v, float out[4])
     int i = (int)x;
     float f = x - (float)i;
     for (int c = 0; c < 4; ++c)
-        out[c] = lerp(tf[4 * i + c], tf[4 * i + 4 + c], f);
+        out[c] = lerp_fma(tf[4 * i + c], tf[4 * i + 4 + c], f);
 }
 
 /* tf with alpha corrected for the step (as given for step 0), followed by a copy of its last
