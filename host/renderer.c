@@ -662,7 +662,8 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     const int composite = r->opts.mode == UMBRA_RENDER_COMPOSITE;
     st = composite ? umbra__raycast_kernels(r) : UMBRA_SUCCESS;
     if (st == UMBRA_SUCCESS)
-        st = umbra__ensure_buffer(r, &r->samples_buf, sizeof(cl_ulong), CL_MEM_READ_WRITE);
+        st = umbra__ensure_buffer(r, &r->samples_buf, UMBRA_COUNT_LANES * UMBRA_COUNT_LANE_BYTES,
+                                  CL_MEM_READ_WRITE);
     if (st == UMBRA_SUCCESS)
         st = umbra__upload_params(r);
     if (st != UMBRA_SUCCESS)
@@ -679,8 +680,8 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if ((st = umbra__frame_gate(r)) != UMBRA_SUCCESS)
         goto fail;
     /* A fill copies its pattern at the call: nothing points into this stack frame later. */
-    UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0, sizeof zero,
-                                 0, NULL, &ev));
+    UMBRA_CL(clEnqueueFillBuffer(ctx->queue, r->samples_buf, &zero, sizeof zero, 0,
+                                 UMBRA_COUNT_LANES * UMBRA_COUNT_LANE_BYTES, 0, NULL, &ev));
     st = umbra__async_hold(r, ev, 0);
     clReleaseEvent(ev);
     ev = NULL;
@@ -701,10 +702,13 @@ umbra_status umbra__render_into(umbra_renderer r, uint32_t width, uint32_t heigh
     if (st != UMBRA_SUCCESS)
         goto fail;
     r->stats.render_ms = ms;
+    cl_ulong lanes[UMBRA_COUNT_LANES * UMBRA_COUNT_LANE_BYTES / sizeof(cl_ulong)];
+    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->samples_buf, CL_TRUE, 0, sizeof lanes, lanes, 0,
+                                 NULL, NULL));
+    /* Devices without 64-bit atomics count in the low 32 bits of each lane only. */
     cl_ulong samples = 0;
-    UMBRA_CL(clEnqueueReadBuffer(ctx->queue, r->samples_buf, CL_TRUE, 0, sizeof samples, &samples,
-                                 0, NULL, NULL));
-    /* Devices without 64-bit atomics count in the low 32 bits only. */
+    for (size_t i = 0; i < UMBRA_COUNT_LANES; ++i)
+        samples += lanes[i * (UMBRA_COUNT_LANE_BYTES / sizeof(cl_ulong))];
     r->stats.samples = samples;
 fail:
     if (ev)

@@ -11,11 +11,18 @@
 #if defined(cl_khr_int64_base_atomics)
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 #define UMBRA_COUNT_T ulong
-#define UMBRA_COUNT_ADD(p, v) atom_add((p), (ulong)(v))
+#define UMBRA_COUNT_ADD(p, v) atom_add(umbra_count_lane(p), (ulong)(v))
 #else
 #define UMBRA_COUNT_T uint
-#define UMBRA_COUNT_ADD(p, v) atomic_add((p), (uint)(v))
+#define UMBRA_COUNT_ADD(p, v) atomic_add(umbra_count_lane(p), (uint)(v))
 #endif
+
+/* The counter's lane of this work-group (UMBRA_COUNT_LANES, kernels/common/umbra_shared.h). */
+inline __global UMBRA_COUNT_T *umbra_count_lane(__global UMBRA_COUNT_T *p)
+{
+    const size_t group = get_group_id(1) * get_num_groups(0) + get_group_id(0);
+    return p + (group % UMBRA_COUNT_LANES) * (UMBRA_COUNT_LANE_BYTES / sizeof(UMBRA_COUNT_T));
+}
 
 /* For functions of the ray loops that the compiler would otherwise call out of line (PoCL did,
  * copying VolGeom on every call). */

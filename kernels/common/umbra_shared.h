@@ -27,6 +27,15 @@ typedef int int32_t;
  * kernels/common/common.cl); host/volume.c keeps the cells' ranges. */
 #define UMBRA_BRICK_CELLS 4
 
+/* The frame's sample counter (umbra_render_stats.samples) in UMBRA_COUNT_LANES lanes
+ * UMBRA_COUNT_LANE_BYTES apart, each work-group adding to one (UMBRA_COUNT_ADD,
+ * kernels/common/common.cl) and the host summing them: with one counter the cores of a CPU
+ * device passed its cache line back and forth for every pixel's atomic add, 2.7% of the
+ * walnut's unshaded frame on PoCL (docs/performance.md). A lane is read as a 64-bit value; a
+ * device without 64-bit atomics counts in its low 32 bits, the high ones stay 0. */
+#define UMBRA_COUNT_LANES 8
+#define UMBRA_COUNT_LANE_BYTES 128
+
 /* Flags in UmbraFrame.flags. */
 #define UMBRA_FLAG_JITTER 1u
 #define UMBRA_FLAG_SKIP_EMPTY 2u
