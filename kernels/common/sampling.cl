@@ -178,11 +178,13 @@ UMBRA_INLINE float2 voxel_load2(__global const UMBRA_VOXEL_T *restrict v, VolGeo
  * voxel type (UMBRA_VOXEL_KIND 0-2: uchar, ushort, short) loads each pair as one word and
  * splits the four words with vector shifts: PoCL's code for four separate pairs extracted and
  * converted every voxel on its own, a quarter of the instructions of a sample
- * (docs/performance.md). The same values either way: the conversions are exact. */
+ * (docs/performance.md). The same values either way: the conversions are exact. A word holds
+ * its first voxel in its low bits on a little-endian device only; others load the pairs. */
 UMBRA_INLINE void voxel_load_corners(__global const UMBRA_VOXEL_T *restrict v, VolGeom g, size_t b,
                                      size_t oy, size_t oz, float4 *lo, float4 *hi)
 {
-#if UMBRA_VOXEL_KIND == 0 || UMBRA_VOXEL_KIND == 1 || UMBRA_VOXEL_KIND == 2
+#if (UMBRA_VOXEL_KIND == 0 || UMBRA_VOXEL_KIND == 1 || UMBRA_VOXEL_KIND == 2) &&                 \
+    defined(__ENDIAN_LITTLE__)
 #if UMBRA_VOXEL_KIND == 0
 #define UMBRA_PAIR(i) (uint)as_ushort(vload2(0, v + (i)))
 #else
@@ -198,7 +200,7 @@ UMBRA_INLINE void voxel_load_corners(__global const UMBRA_VOXEL_T *restrict v, V
     *lo = convert_float4(w & 0xffffu);
     *hi = convert_float4(w >> 16);
 #else
-    *lo = convert_float4((as_int4(w) << 16) >> 16);
+    *lo = convert_float4(as_int4(w << 16) >> 16);
     *hi = convert_float4(as_int4(w) >> 16);
 #endif
 #if UMBRA_VOXEL_CLAMPS
