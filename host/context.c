@@ -477,6 +477,12 @@ static umbra_status program_get_locked(umbra_context ctx, const char *const *fil
 {
     umbra_status st = UMBRA_SUCCESS;
     const char *sources[16];
+    /* Refused before anything reads files[]: a count from umbra__program_files above its
+     * caller's array means the list did not fit. */
+    if (nfiles == 0 || nfiles + 1 > sizeof sources / sizeof sources[0])
+        return umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                           "umbra__program_get: %zu kernel files (1 to %zu)", nfiles,
+                           sizeof sources / sizeof sources[0] - 1);
     char *key = program_key(files, nfiles, options);
     char *log = NULL;
     cl_program program = NULL;
@@ -489,10 +495,6 @@ static umbra_status program_get_locked(umbra_context ctx, const char *const *fil
             *out = p->program;
             return UMBRA_SUCCESS;
         }
-    }
-    if (nfiles + 1 > sizeof sources / sizeof sources[0]) {
-        st = umbra__fail(ctx, UMBRA_ERROR_INVALID_ARGUMENT, "umbra__program_get: %zu files", nfiles);
-        goto fail;
     }
     sources[0] = umbra__kernel_source("common/umbra_shared.h");
     for (size_t i = 0; i < nfiles; ++i) {

@@ -489,11 +489,14 @@ size_t umbra__program_files(const umbra__technique *t, const char *const *common
                             const char *const *after, const char **files, size_t max)
 {
     size_t n = 0;
-    for (size_t i = 0; i < ncommon && n < max; ++i)
-        files[n++] = common[i];
-    for (const char *const *f = t->kernel_files; f && *f && n < max; ++f)
-        files[n++] = *f;
-    for (const char *const *f = after; f && *f && n < max; ++f)
-        files[n++] = *f;
+    for (size_t i = 0; i < ncommon; ++i, ++n)
+        if (n < max)
+            files[n] = common[i];
+    for (const char *const *f = t->kernel_files; f && *f; ++f, ++n)
+        if (n < max)
+            files[n] = *f;
+    for (const char *const *f = after; f && *f; ++f, ++n)
+        if (n < max)
+            files[n] = *f;
     return n;
 }

@@ -468,7 +468,8 @@ const umbra__technique *umbra__technique_by_id(umbra_shadow_technique id);
 
 /* The technique's own kernel files (t->kernel_files) inserted into a program's file list: the
  * common files first, then the technique's, then those of `after` (NULL-terminated; may be NULL);
- * returns the count, at most max (the caller's array). */
+ * writes at most max (the caller's array) and returns how many the lists hold: a count above max
+ * (which umbra__program_get refuses before it reads a file) says the array was too small. */
 size_t umbra__program_files(const umbra__technique *t, const char *const *common, size_t ncommon,
                             const char *const *after, const char **files, size_t max);
 

@@ -15,7 +15,9 @@
  *    naming the technique, the parameter and the value, while another technique's parameters are
  *    neither checked nor compared;
  *  - changing another technique's parameter does not rebuild; the technique's own parameters
- *    flagged UMBRA_PARAM_REBUILDS do, the others do not.
+ *    flagged UMBRA_PARAM_REBUILDS do, the others do not;
+ *  - every technique's kernel files fit a program's file list (umbra__program_files), and a list
+ *    that does not fit is counted past its array and refused by umbra__program_get by its count.
  * Usage: test_conformance [filter] (a cmocka test-name glob). */
 #include <math.h>
 #include <stdlib.h>
@@ -442,6 +444,43 @@ static void test_conformance_only_own_parameters_rebuild(void **state)
     umbra_scene_release(&sc);
 }
 
+/* ---- program file lists ---------------------------------------------------------------------- */
+
+static void test_conformance_program_files_fit_or_refused(void **state)
+{
+    (void)state;
+    /* The ray caster's list (host/renderer.c): five common files, the technique's, raycast.cl. */
+    static const char *const common[] = {"common/common.cl", "common/sampling.cl",
+                                         "common/channels.cl", "common/lightspace.cl",
+                                         "common/preintegration.cl"};
+    static const char *const after[] = {"raycast.cl", NULL};
+    for (uint32_t ti = 0; ti < umbra_technique_count(); ++ti) {
+        const umbra__technique *t = umbra__technique_by_id(umbra_technique_get(ti)->id);
+        const char *files[16];
+        const size_t n = umbra__program_files(t, common, 5, after, files, 16);
+        assert_in_range(n, 6, 15);
+        assert_string_equal(files[n - 1], "raycast.cl");
+        /* Two entries fewer than it needs: counted in full, written up to the array's end. */
+        const char *few[16] = {NULL};
+        assert_int_equal(umbra__program_files(t, common, 5, after, few, n - 2), n);
+        assert_null(few[n - 2]);
+    }
+    /* A count past the 15 a program holds is refused before a file is read, naming it. */
+    const char *many[17];
+    for (size_t i = 0; i < 17; ++i)
+        many[i] = "common/common.cl";
+    cl_program program = NULL;
+    assert_int_equal(umbra__program_get(ctx, many, 17, "", &program),
+                     UMBRA_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(umbra_context_last_message(ctx), "17 kernel files"));
+    assert_null(program);
+    assert_int_equal(umbra__program_get(ctx, many, 0, "", &program),
+                     UMBRA_ERROR_INVALID_ARGUMENT);
+    /* The context is still usable. */
+    assert_int_equal(umbra__program_get(ctx, many, 1, "", &program), UMBRA_SUCCESS);
+    assert_non_null(program);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -450,6 +489,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_conformance_rebuild_equals_fresh),
         cmocka_unit_test(test_conformance_bad_parameters_refused_by_name),
         cmocka_unit_test(test_conformance_only_own_parameters_rebuild),
+        cmocka_unit_test(test_conformance_program_files_fit_or_refused),
     };
     if (argc > 1)
         cmocka_set_test_filter(argv[1]);
