@@ -9,6 +9,7 @@
  * PART_INDEX). */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -495,21 +496,29 @@ static umbra_status deep_state_check(umbra_renderer r, const char *fn, const flo
     const uint32_t started = npts + 1;
     for (size_t t = 0; t < (size_t)n * n; ++t) {
         const float *x = s + t * per;
-        for (uint32_t c = 0; c < C; ++c) {
-            const char *why = NULL;
-            if (x[started] == 0.0f && x[npts] != 0.0f)
-                why = "points since the origin must be 0 while the origin is not emitted";
-            else if (x[started] == 0.0f && x[v0 + c] != 1.0f)
+        /* The point count and the origin's flag are the texel's, not a channel's. */
+        const char *why = x[started] == 0.0f && x[npts] != 0.0f
+                              ? "points since the origin must be 0 while the origin is not emitted"
+                              : NULL;
+        int channel = -1; /* the channel refused, if a channel's field is */
+        for (uint32_t c = 0; !why && c < C; ++c) {
+            if (x[started] == 0.0f && x[v0 + c] != 1.0f)
                 why = "fit origin visibility must be 1 while the origin is not emitted";
             else if (x[npts] > 0.0f && !(x[lo + c] <= x[hi + c]))
                 why = "lowest slope must not exceed the highest once points are fed";
-            if (why)
-                return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
-                                   "%s: texel %zu (%zu, %zu), channel %u: %s (points %g, origin "
-                                   "emitted %g, origin visibility %g, slopes [%g, %g]; technique "
-                                   "deep's march state)", fn, t, t % n, t / n, c, why,
-                                   (double)x[npts], (double)x[started], (double)x[v0 + c],
-                                   (double)x[lo + c], (double)x[hi + c]);
+            channel = why ? (int)c : -1;
+        }
+        if (why) {
+            char named[32] = "";
+            if (channel >= 0)
+                snprintf(named, sizeof named, ", channel %d", channel);
+            const uint32_t c = channel >= 0 ? (uint32_t)channel : 0;
+            return umbra__fail(r->ctx, UMBRA_ERROR_INVALID_ARGUMENT,
+                               "%s: texel %zu (%zu, %zu)%s: %s (points %g, origin emitted %g, "
+                               "origin visibility %g, slopes [%g, %g]; technique deep's march "
+                               "state)", fn, t, t % n, t / n, named, why, (double)x[npts],
+                               (double)x[started], (double)x[v0 + c], (double)x[lo + c],
+                               (double)x[hi + c]);
         }
     }
     return UMBRA_SUCCESS;
