@@ -184,7 +184,7 @@ __kernel void raycast_render(__global const UmbraFrame *F, VOLUME_PARAM,
          * image is the same bit for bit. The light point (l_pend) is computed when the sample
          * is composited, where its opacity is at hand, not at the lookup: the same arithmetic,
          * placed where the processor can start it a sample earlier. What both gained:
-         * docs/performance.md, "Behind the kernels' comments" (issue #12). */
+         * docs/performance-log.md, "Behind the kernels' comments" (issue #12). */
         int pending = 0;
         float3 p_pend = (float3)(0.0f), l_pend = (float3)(0.0f);
         float4 c_pend = (float4)(0.0f);

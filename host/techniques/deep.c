@@ -579,7 +579,8 @@ const umbra__technique umbra__technique_deep = {
         /* While the light moves (interaction auto): half a texel per voxel (a sixteenth of the
          * full map's texels), a step of one voxel and epsilon 0.06 (the deep-shadow paper's
          * "lower resolution and higher error bound during interaction"); the build is then a
-         * small part of the frame, whose cost is the lookups (docs/performance.md, 2026-12-02). */
+         * small part of the frame, whose cost is the lookups (docs/performance-log.md,
+         * 2026-12-02). */
         .draft = "map_texels_per_voxel<=0.5;map_step>=1;epsilon>=0.06",
     },
     .params = params,

@@ -199,7 +199,7 @@ inline int3 floor_int3(float3 x)
 /* |v| and v / |v| where they run per sample. PoCL's length() and normalize() guard against
  * overflow and underflow by scaling, which costs several times the square root; the vectors here
  * (gradients, offsets within the scene) are far from either, and the results were the same bit
- * for bit on every image checked. What it gained: docs/performance.md, "Behind the kernels'
+ * for bit on every image checked. What it gained: docs/performance-log.md, "Behind the kernels'
  * comments" (issue #12). */
 inline float umbra_length(float3 v) { return sqrt(dot(v, v)); }
 
@@ -500,7 +500,7 @@ inline float4 to_light(__global const UmbraFrame *F, float3 p)
 }
 
 /* x^n for x in [0, 1] and n > 0: Blinn-Phong's specular |N.H|^shininess. pow() was the costliest
- * call of a shaded sample on PoCL (docs/performance.md, "Behind the kernels' comments"): it
+ * call of a shaded sample on PoCL (docs/performance-log.md, "Behind the kernels' comments"): it
  * handles every sign, range and exponent and rounds nearly exactly. A whole
  * exponent up to UMBRA_POWER_BY_SQUARING, as shininess almost always is, is taken by binary
  * powering instead: at most 2 log2(n) multiplications, each adding half an ulp, whose errors

@@ -417,7 +417,7 @@ inline float3 volume_gradient(VOLUME_PARAM, VolGeom g, float3 p)
  * as all six share p's fractions, each axis' component is the trilinear interpolation, over p's
  * cell, of the voxels' central differences v[i+1] - v[i-1]. Six separate samples cost 48 loads
  * and six index computations, which made PoCL's shaded frames markedly costlier than this
- * (measured: docs/performance.md, "Behind the kernels' comments"). Indices come from the
+ * (measured: docs/performance-log.md, "Behind the kernels' comments"). Indices come from the
  * unclamped position and are
  * clamped one by one, which repeats the border voxels exactly as clamping each sample's
  * position does (a position clamped to the border interpolates between two copies of the

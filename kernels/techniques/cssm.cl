@@ -73,7 +73,7 @@ inline void shadow_ray_init(ShadowRay *sr) { sr->unused = 0; }
 /* light_depth (kernels/common/common.cl) without its library call: the march needs a segment's
  * optical
  * depth at every segment of material, and PoCL's log1p, a call per segment, was a large part of
- * a build (docs/performance.md, "Behind the kernels' comments"). For alpha up to 0.5,
+ * a build (docs/performance-log.md, "Behind the kernels' comments"). For alpha up to 0.5,
  * -ln(1 - a) = 2 atanh(s) with s = a / (2 - a) <= 1/3, summed to s^13: within 1.8 float epsilons
  * of the exact value at every float a in (0, 0.5] (checked against a double log1p), where
  * log1p is within 0.7; above 0.5, 1 - a is exact and a plain logarithm serves (rare: such a

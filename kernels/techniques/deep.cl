@@ -45,8 +45,8 @@
 /* Sub-texel rays per texel (desc->prefilter, 1 or 5), a build option of the build program, not a
  * kernel argument: with the count known the compiler sizes the per-ray arrays to it and can
  * unroll the loops over the rays. The arithmetic and its order are unchanged, so the maps are
- * the same bit for bit; the gain is small, the march itself is the cost (docs/performance.md,
- * "Behind the kernels' comments"; issue #12). */
+ * the same bit for bit; the gain is small, the march itself is the cost
+ * (docs/performance-log.md, "Behind the kernels' comments"; issue #12). */
 #ifndef DEEP_SUB_RAYS
 #define DEEP_SUB_RAYS 1
 #endif
@@ -377,7 +377,7 @@ inline int deep_quant(float s)
  * to e and returns their number (at most DEEP_MAX_EMIT: one per distinct position, one for the
  * gap point, one for the fit's first node, three when the ray ends). Sets T->done at the end.
  * Always inlined: called, it kept the texel's state in memory, and the build was slower on PoCL
- * (docs/performance.md, "Behind the kernels' comments"). */
+ * (docs/performance-log.md, "Behind the kernels' comments"). */
 UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PARAM, VolGeom g,
                            __global const float4 *light_tf, __global const ulong *light_cells,
                            __global const UmbraShadow *S, __global const deep_node *lut,

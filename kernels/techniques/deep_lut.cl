@@ -74,7 +74,7 @@ __kernel void deep_lut(__global const UmbraFrame *F, __global const float4 *ligh
          * again: the entry is the first fit's if it is feasible, else the last feasible
          * halving's, else the line's. Fitting the chosen tolerance once more, as this did
          * before, cost the table more CPU time for the same table bit for bit
-         * (docs/performance.md, "Behind the kernels' comments"; issue #12). */
+         * (docs/performance-log.md, "Behind the kernels' comments"; issue #12). */
         int interior = deep_lut_fit(v, DEEP_LUT_TOL, DEEP_LUT_INTERIOR, out);
         if (interior > DEEP_LUT_INTERIOR) {
             float lo = DEEP_LUT_TOL, hi = DEEP_LUT_TOL;
