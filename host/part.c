@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/part.c: volumes that are parts of a global grid (umbra/part.h), and the host helpers that
  * compose what parts render: the visibility order of parts, the over operator on partial images,
- * the product and minimum of light-space arrays. The renderer's side of a part (its view segment,
- * its light exchange) is host/part_render.c. */
+ * the product and minimum of light-space arrays. The renderer's side of a part is
+ * host/part_render.c (its view segment) and host/part_light.c (its light exchange). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -210,7 +210,7 @@ struct umbra_renderer_t {
     umbra__async *async;                     /* the asynchronous frame in progress, or NULL */
     int part_call;                           /* umbra_renderer_render_part is rendering */
     int part_front;                          /* ... going on from the front state in out_buf */
-    /* A part's light exchange (host/part_render.c): the march state imported (host, NULL: none
+    /* A part's light exchange (host/part_light.c): the march state imported (host, NULL: none
      * yet), its device copy the build reads and writes, and the shadow build count at the last
      * import of depths. */
     float *part_state_in;
@@ -411,7 +411,7 @@ void umbra__channel_tfs(umbra_renderer r, int light, umbra_transfer_function *ou
 void umbra__part_frame(umbra_renderer r, int view);
 
 /* Binds a part's march state (n^2 texels) as argument index of a map's build kernel, uploading
- * the imported state (or the light's: transmittance 1) first (host/part_render.c). */
+ * the imported state (or the light's: transmittance 1) first (host/part_light.c). */
 umbra_status umbra__part_bind_build(umbra_renderer r, cl_kernel k, cl_uint index, uint32_t n);
 
 /* Light tables and the shadow structure, rebuilt only when the light key changed

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-/* tests/test_part.c: a volume split into parts (umbra/part.h, host/part.c, host/part_render.c),
- * in one process, against the single-device render of the whole volume:
+/* tests/test_part.c: a volume split into parts (umbra/part.h, host/part.c, host/part_render.c,
+ * host/part_light.c), in one process, against the single-device render of the whole volume:
  *  - the analytic volume below split 2x1x1, 2x2x1, 2x2x2 and 2x1x1 with an empty part; each part
  *    a part volume with the ghost layers umbra_part_ghost_needed asks for, rendered with
  *    umbra_renderer_render_part, the partial images composited in the order
@@ -394,7 +394,7 @@ static void test_bad_input_refused(void **state)
         assert_int_equal(li.kind, UMBRA_PART_LIGHT_TAU);
         /* Its state is the whole march's (kernels/techniques/deep_shared.h): with one light
          * channel 13 floats a texel, a node 2. A bad value is refused naming the texel, the
-         * field and the value (the table in host/part_render.c, shared with threshold and
+         * field and the value (the table in host/part_light.c, shared with threshold and
          * CSSM): a visibility above 1, a count that is not an integer, a NaN depth. */
         assert_int_equal(li.channels, DEEP_PART_STATE_FLOATS(1));
         assert_int_equal(li.node_floats, 2);

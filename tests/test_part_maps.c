@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-/* tests/test_part_maps.c: the light-space maps on parts (umbra/part.h, host/part_render.c), in
+/* tests/test_part_maps.c: the light-space maps on parts (umbra/part.h, host/part_light.c), in
  * one process, against one device's render of the whole volume (tests/part_scene.h):
  *  - the threshold map and CSSM (grey and coloured transmission) on parts: the march state
  *    passed on in light order (umbra_part_visibility_order from the light), the depths reduced

@@ -305,7 +305,7 @@ static umbra_status build_blocked(umbra_renderer r, deep_state *s, double *ms)
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof(cl_mem), &s->counter));
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof capacity, &capacity));
         UMBRA_CL(clSetKernelArg(s->k_build, next++, sizeof limit, &limit));
-        /* A part marches on from the visibility imported (host/part_render.c), written again
+        /* A part marches on from the visibility imported (host/part_light.c), written again
          * before each pass: the kernel leaves the exit visibility in its place. */
         if (r->volume->is_part && (st = umbra__part_bind_build(r, s->k_build, next++, n)) !=
                                       UMBRA_SUCCESS)

@@ -55,7 +55,7 @@ umbra_status umbra__deep_set_limit(umbra_renderer r, size_t blocks);
 umbra_status umbra__deep_read(umbra_renderer r, int32_t *head, int32_t *next, uint32_t *counts,
                               float *nodes);
 
-/* A part's pieces of the unbounded map (host/techniques/deep_part.c, for host/part_render.c):
+/* A part's pieces of the unbounded map (host/techniques/deep_part.c, for host/part_light.c):
  * the export writes the built map's node count per texel (map_size^2) and, unless nodes is
  * NULL, its nodes in texel order (1 + channels floats each; *node_count their capacity in, their
  * number out); the import merges the pieces of `parts` parts (counts: parts x map_size^2,

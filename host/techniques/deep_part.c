@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 /* host/techniques/deep_part.c: the deep shadow map on parts (include/umbra/part.h,
- * docs/distributed.md; host/part_render.c calls it). A part's map holds, per texel, the pieces
+ * docs/distributed.md; host/part_light.c calls it). A part's map holds, per texel, the pieces
  * of the texel's visibility function its core owns: the nodes of the segments of the light ray
  * inside its core (kernels/techniques/deep.cl under UMBRA_PART). The export reads them back in
  * texel order; the import merges the pieces of all parts per texel in depth order, which is one

@@ -136,7 +136,7 @@ umbra_status umbra__map_build(umbra_renderer r, double *ms)
         return st;
     UMBRA_CL(clSetKernelArg(s->build_kernel, next++, sizeof(cl_mem), &s->constants_buf));
     UMBRA_CL(clSetKernelArg(s->build_kernel, next, sizeof(cl_mem), &s->map));
-    /* A part's march goes on from the state the parts before it left (host/part_render.c). */
+    /* A part's march goes on from the state the parts before it left (host/part_light.c). */
     if (r->volume->is_part && (st = umbra__part_bind_build(r, s->build_kernel, next + 1, n)))
         return st;
     const size_t blocks = (n + block - 1) / block;
