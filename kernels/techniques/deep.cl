@@ -549,7 +549,31 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
      * agree node for node at any epsilon (tests/test_deep.c, test_skipping_changes_nothing;
      * tests/test_part_maps.c). */
     if (any_points && !flat) {
-        /* The union of the sub-rays' positions, sorted, without repeats. */
+        /* A segment that follows empty or flat ones starts with a point at its front end, so
+         * the fit sees the flat stretch before it as flat. */
+        float z_front = (float)T->k * T->zstep;
+        if (z_front > T->z_pushed) {
+            deep_fit_push(&T->fit, z_front, v_start, T->eps, e, &ne);
+            T->z_pushed = z_front;
+        }
+#if DEEP_SUB_RAYS == 1
+        /* One ray: its points are in order (a table entry's interior nodes, then its end; or
+         * the partial segment's entry and end), and the visibility at each is the point's own,
+         * taken as it is rather than interpolated to it from the point before (a division and
+         * a search per point, docs/performance-log.md, 2026-12-04). */
+        float last = -1.0f;
+        for (int q = 0; q < pts[0].n; ++q) {
+            const float x = pts[0].x[q];
+            if (!(x > last + 1e-6f) || !(x > 0.0f))
+                continue;
+            last = x;
+            const float z = ((float)T->k + x) * T->zstep;
+            deep_fit_push(&T->fit, z, pts[0].v[q], T->eps, e, &ne);
+            T->z_pushed = z;
+        }
+#else
+        /* The union of the sub-rays' positions, sorted, without repeats, and at each the
+         * filter-weighted sum of the sub-rays' visibilities there. */
         float xs[DEEP_MAX_POINTS];
         int nx = 0;
         for (int i = 0; i < DEEP_SUB_RAYS; ++i)
@@ -563,13 +587,6 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
                 xs[q] = x;
                 ++nx;
             }
-        /* A segment that follows empty or flat ones starts with a point at its front end, so
-         * the fit sees the flat stretch before it as flat. */
-        float z_front = (float)T->k * T->zstep;
-        if (z_front > T->z_pushed) {
-            deep_fit_push(&T->fit, z_front, v_start, T->eps, e, &ne);
-            T->z_pushed = z_front;
-        }
         float last = -1.0f;
         for (int q = 0; q < nx; ++q) {
             float x = xs[q];
@@ -583,6 +600,7 @@ UMBRA_INLINE int deep_step(DeepTexel *T, __global const UmbraFrame *F, VOLUME_PA
             deep_fit_push(&T->fit, z, v, T->eps, e, &ne);
             T->z_pushed = z;
         }
+#endif
     }
 
     /* Next segment, or a jump over bricks (or sub-cells) that are empty for every sub-ray. The
